@@ -1,0 +1,38 @@
+"""Collective gathering: a PettingZoo environment with pymunk physics and configurable sensors.
+
+Public names::
+
+    parallel_env, env, raw_env          env factories (ParallelEnv, AEC with wrappers, raw AEC)
+    SensorSpec, Morphology, SENSOR_TYPES  sensor suite description and per-type bounds
+    morphological_complexity            paper eq. 2 (higher = simpler)
+    WorldConfig, ENVIRONMENT_PRESETS    every world parameter, paper Table 2 presets
+
+Importing the package registers ``gathering_env/CollectiveGathering-v0`` in PettingZoo's
+registry: ``pettingzoo.make("parallel", "gathering_env/CollectiveGathering-v0", environment=2)``
+(and ``"aec"``).
+"""
+
+from pettingzoo import register as _register
+
+from .config import ENVIRONMENT_PRESETS, WorldConfig
+from .env import GatheringEnv, env, parallel_env, raw_env
+from .sensors import SENSOR_TYPES, Morphology, SensorSpec, morphological_complexity
+
+ENV_ID = "gathering_env/CollectiveGathering-v0"
+
+_register("parallel", ENV_ID, entry_point="gathering_env.env:parallel_env")
+_register("aec", ENV_ID, entry_point="gathering_env.env:env")
+
+__all__ = [
+    "ENVIRONMENT_PRESETS",
+    "ENV_ID",
+    "SENSOR_TYPES",
+    "GatheringEnv",
+    "Morphology",
+    "SensorSpec",
+    "WorldConfig",
+    "env",
+    "morphological_complexity",
+    "parallel_env",
+    "raw_env",
+]

@@ -1,0 +1,234 @@
+"""Every world parameter of the collective gathering task in one validated dataclass.
+
+Units: lengths in world units (the arena is 40 x 40 by default, SPEC section 1),
+time in seconds, angles in radians, masses in mass units, forces in force units
+(the pymunk solver's units; only their ratios matter).
+
+``WorldConfig.from_kwargs(environment=2, num_robots=20, ...)`` builds a config from an
+environment preset (paper Table 2) and keyword overrides of any field; every field is
+range-checked and a bad value raises ``ValueError`` naming the field, the value and the
+allowed range.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import asdict, dataclass, field, fields
+from typing import Any
+
+#: Paper Table 2: (small, medium, large) block counts per environment preset.
+ENVIRONMENT_PRESETS: dict[int, tuple[int, int, int]] = {
+    1: (10, 5, 0),  # low cooperation
+    2: (5, 5, 5),
+    3: (0, 5, 10),  # high cooperation
+}
+
+#: Names of the three block types, index = type id.
+BLOCK_TYPE_NAMES: tuple[str, str, str] = ("small", "medium", "large")
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    """All parameters of the arena, robots, blocks, heuristics and scoring.
+
+    Defaults follow SPEC section 1-4 (the original implementation's numbers where the
+    paper is silent). Every field can be overridden through ``parallel_env(**kwargs)``.
+    """
+
+    # --- arena and simulation -------------------------------------------------------
+    arena_width: float = 40.0
+    """Arena extent along x (units); walls enclose [0, arena_width] x [0, arena_height]."""
+    arena_height: float = 40.0
+    dt: float = 0.1
+    """Physics time step per environment step (s)."""
+    physics_iterations: int = 10
+    """pymunk solver iterations per step."""
+    max_cycles: int = 10_000
+    """Steps per trial before truncation (SPEC: 10 000)."""
+
+    # --- team ----------------------------------------------------------------------
+    num_robots: int = 20
+    robot_radius: float = 0.15
+    robot_mass: float = 0.7
+    robot_friction: float = 0.7
+    """Contact (Coulomb) friction of robot shapes."""
+    robot_max_speed: float = 0.5
+    """Top wheel speed (units/s); the robot's top speed when both wheels drive at 1."""
+    robot_drive_force: float = 1.0
+    """Maximum traction force a robot's wheels exert on the ground (force units)."""
+    robot_drive_torque: float = 0.1
+    """Maximum turning torque of a robot's wheels."""
+
+    # --- blocks (index 0/1/2 = small/medium/large) ------------------------------------
+    block_counts: tuple[int, int, int] = ENVIRONMENT_PRESETS[2]
+    block_sizes: tuple[float, float, float] = (0.4, 0.6, 0.8)
+    """Side length of the square blocks (units)."""
+    block_masses: tuple[float, float, float] = (1.0, 3.0, 6.0)
+    block_values: tuple[float, float, float] = (1.0, 2.0, 3.0)
+    robots_needed: tuple[int, int, int] = (1, 2, 3)
+    block_friction_margin: float = 0.5
+    """A block needing k robots has ground friction (k - margin) * robot_drive_force,
+    so k - 1 robots at full drive cannot move it and k robots can. In (0, 1)."""
+    block_friction: float = 0.7
+    """Contact (Coulomb) friction of block shapes."""
+
+    # --- gathering zone --------------------------------------------------------------
+    zone_width: float = 20.0
+    """Width of the gathering zone along the south wall (units), centred in x."""
+    zone_depth: float = 8.0
+    """Depth of the zone from the south wall (units); the paper's 0.5 x 0.2 arena."""
+
+    # --- heuristics ------------------------------------------------------------------
+    pickup_heuristic: bool = True
+    pickup_box_width: float = 0.1
+    pickup_box_depth: float = 0.2
+    pickup_reach: float = 2.5
+    """A robot attaches only within this many robot radii of a free anchor point."""
+    pickup_positioning: bool = False
+    """Snap an attaching robot onto its anchor, facing the block (original option, off)."""
+    collision_avoidance: bool = False
+    """Turn away from robots/walls just ahead, overriding the controller (original option, off)."""
+    collision_avoidance_distance: float = 0.3
+    """Clearance ahead (units) that triggers the collision-avoidance turn."""
+
+    # --- sensing ---------------------------------------------------------------------
+    ir_response: str = "linear"
+    """'linear': 1 - d/range; 'gamma': (1 - d/range) ** ir_gamma (Khepera-like curve)."""
+    ir_gamma: float = 3.0
+    bottom_falloff: float = 1.0
+    """Distance outside the zone (units) over which the bottom sensor falls from 1 to 0."""
+
+    # --- scoring ---------------------------------------------------------------------
+    time_bonus: float = 20.0
+    """Bonus for gathering every block, scaled by the unused fraction of steps (paper: 20,
+    original code: 10)."""
+
+    environment: int | None = field(default=2, compare=False)
+    """Preset the block counts came from (informational; None if counts were overridden)."""
+
+    # ---------------------------------------------------------------------------------
+    @classmethod
+    def from_kwargs(cls, environment: int | None = 2, **overrides: Any) -> WorldConfig:
+        """Build a config from an environment preset (1, 2 or 3) and field overrides."""
+        if environment is not None:
+            if isinstance(environment, bool) or environment not in ENVIRONMENT_PRESETS:
+                raise ValueError(
+                    f"environment={environment!r} is not a preset; allowed: "
+                    f"{sorted(ENVIRONMENT_PRESETS)} (or None with block_counts=...)"
+                )
+        allowed = {f.name for f in fields(cls)} - {"environment"}
+        unknown = sorted(set(overrides) - allowed)
+        if unknown:
+            raise ValueError(
+                f"unknown world parameter(s) {unknown}; allowed: {sorted(allowed)}"
+            )
+        values = dict(overrides)
+        if "block_counts" not in values:
+            if environment is None:
+                raise ValueError("environment=None needs block_counts=(small, medium, large)")
+            values["block_counts"] = ENVIRONMENT_PRESETS[environment]
+        for name in ("block_counts", "block_sizes", "block_masses", "block_values", "robots_needed"):
+            if name in values:
+                values[name] = _triple(name, values[name])
+        return cls(environment=environment, **values)
+
+    def __post_init__(self) -> None:
+        _check_int("num_robots", self.num_robots, 1, 1000)
+        _check_int("max_cycles", self.max_cycles, 1, 10**9)
+        _check_int("physics_iterations", self.physics_iterations, 1, 1000)
+        for name in (
+            "arena_width", "arena_height", "dt", "robot_radius", "robot_mass",
+            "robot_max_speed", "robot_drive_force", "robot_drive_torque",
+            "zone_width", "zone_depth", "pickup_box_width", "pickup_box_depth",
+            "pickup_reach", "collision_avoidance_distance", "ir_gamma", "bottom_falloff",
+        ):
+            _check_float(name, getattr(self, name), 0.0, math.inf, low_open=True)
+        for name in ("robot_friction", "block_friction", "time_bonus"):
+            _check_float(name, getattr(self, name), 0.0, math.inf)
+        _check_float("block_friction_margin", self.block_friction_margin, 0.0, 1.0,
+                     low_open=True, high_open=True)
+        for i, count in enumerate(self.block_counts):
+            _check_int(f"block_counts[{i}] ({BLOCK_TYPE_NAMES[i]})", count, 0, 10_000)
+        for i in range(3):
+            label = BLOCK_TYPE_NAMES[i]
+            _check_float(f"block_sizes[{i}] ({label})", self.block_sizes[i], 0.0, math.inf, low_open=True)
+            _check_float(f"block_masses[{i}] ({label})", self.block_masses[i], 0.0, math.inf, low_open=True)
+            _check_float(f"block_values[{i}] ({label})", self.block_values[i], 0.0, math.inf, low_open=True)
+            _check_int(f"robots_needed[{i}] ({label})", self.robots_needed[i], 1, 100)
+        if self.zone_width > self.arena_width:
+            raise ValueError(
+                f"zone_width={self.zone_width} must be <= arena_width={self.arena_width}"
+            )
+        if self.zone_depth >= self.arena_height:
+            raise ValueError(
+                f"zone_depth={self.zone_depth} must be < arena_height={self.arena_height}"
+            )
+        for name, value in (("pickup_heuristic", self.pickup_heuristic),
+                            ("pickup_positioning", self.pickup_positioning),
+                            ("collision_avoidance", self.collision_avoidance)):
+            if not isinstance(value, bool):
+                raise ValueError(f"{name}={value!r} must be a bool (True or False)")
+        if self.ir_response not in ("linear", "gamma"):
+            raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma'")
+        if sum(self.block_counts) == 0:
+            raise ValueError("block_counts=(0, 0, 0): the world needs at least one block")
+
+    # --- derived quantities -----------------------------------------------------------
+    @property
+    def zone_rect(self) -> tuple[float, float, float, float]:
+        """Gathering zone as (x_min, y_min, x_max, y_max), along the south wall (y = 0)."""
+        x0 = 0.5 * (self.arena_width - self.zone_width)
+        return (x0, 0.0, x0 + self.zone_width, self.zone_depth)
+
+    @property
+    def zone_centre(self) -> tuple[float, float]:
+        x0, y0, x1, y1 = self.zone_rect
+        return (0.5 * (x0 + x1), 0.5 * (y0 + y1))
+
+    @property
+    def num_blocks(self) -> int:
+        return int(sum(self.block_counts))
+
+    @property
+    def total_value(self) -> float:
+        """Sum of the values of all blocks in the world (v_t of eq. 1)."""
+        return float(sum(c * v for c, v in zip(self.block_counts, self.block_values)))
+
+    def block_ground_friction(self, block_type: int) -> float:
+        """Ground friction force (force units) of a block of the given type."""
+        need = self.robots_needed[block_type]
+        return (need - self.block_friction_margin) * self.robot_drive_force
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe dict of every field (tuples become lists)."""
+        return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()}
+
+
+def _triple(name: str, value: Any) -> tuple:
+    try:
+        items = tuple(value)
+    except TypeError:
+        raise ValueError(f"{name}={value!r} must be a sequence of 3 values (small, medium, large)") from None
+    if len(items) != 3:
+        raise ValueError(f"{name}={value!r} must have exactly 3 entries (small, medium, large)")
+    return items
+
+
+def _check_int(name: str, value: Any, low: int, high: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ValueError(f"{name}={value!r} must be an integer in [{low}, {high}]")
+    if not low <= int(value) <= high:
+        raise ValueError(f"{name}={value!r} out of range; allowed: [{low}, {high}]")
+
+
+def _check_float(name: str, value: Any, low: float, high: float, *,
+                 low_open: bool = False, high_open: bool = False) -> None:
+    allowed = f"{'(' if low_open else '['}{low}, {high}{')' if high_open else ']'}"
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name}={value!r} must be a number in {allowed}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{name}={value!r} must be finite, in {allowed}")
+    if x < low or x > high or (low_open and x == low) or (high_open and x == high):
+        raise ValueError(f"{name}={value!r} out of range; allowed: {allowed}")

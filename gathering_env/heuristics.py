@@ -1,0 +1,105 @@
+"""Team heuristics as array operations: pickup detection, attached-robot drive, avoidance.
+
+* **Pickup** (SPEC section 2, on by default): a robot whose pickup box (``pickup_box_width``
+  wide, ``pickup_box_depth`` deep, in front of its rim) holds an ungathered block with a
+  free anchor attaches to it (``GatheringWorld.try_attach``).
+* **Attached drive**: an attached robot ignores its controller and drives at full power
+  towards the gathering zone's centre, forwards when the centre lies ahead of it and
+  backwards (pulling its block) when it lies behind, steering proportionally to the
+  heading error.
+* **Collision avoidance** (optional, off by default): a free robot with another robot or
+  a wall closer than ``collision_avoidance_distance`` ahead of its front turns on the spot,
+  away from the obstacle, instead of following its controller.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .world import GatheringWorld
+
+
+def pickup_candidates(world: GatheringWorld, gathered: np.ndarray) -> list[tuple[int, int]]:
+    """(robot, block) pairs where a free robot has an attachable block in its pickup box.
+
+    Args:
+        world: the current world.
+        gathered: (B,) bool, blocks wholly inside the zone (never picked up).
+    """
+    cfg = world.config
+    free_robots = np.flatnonzero(world.robot_attached < 0)
+    if free_robots.size == 0:
+        return []
+    owners = (world.anchor_owner >= 0).sum(axis=1)
+    open_blocks = ~gathered & ((world.block_sticky_side < 0) | (owners < world.block_need))
+    blocks = np.flatnonzero(open_blocks)
+    if blocks.size == 0:
+        return []
+    pos = world.robot_pos[free_robots]
+    ang = world.robot_angle[free_robots]
+    hx, hy = np.cos(ang), np.sin(ang)
+    centre_offset = cfg.robot_radius + 0.5 * cfg.pickup_box_depth
+    box_x = pos[:, 0] + centre_offset * hx                         # (R,)
+    box_y = pos[:, 1] + centre_offset * hy
+    # Nearest block point to the box centre, per (robot, block).
+    cb, sb = np.cos(world.block_angle[blocks]), np.sin(world.block_angle[blocks])
+    half = world.block_half[blocks]
+    rx = box_x[:, None] - world.block_pos[blocks, 0]
+    ry = box_y[:, None] - world.block_pos[blocks, 1]
+    lx = np.clip(rx * cb + ry * sb, -half, half)
+    ly = np.clip(-rx * sb + ry * cb, -half, half)
+    px = world.block_pos[blocks, 0] + lx * cb - ly * sb - box_x[:, None]
+    py = world.block_pos[blocks, 1] + lx * sb + ly * cb - box_y[:, None]
+    along = px * hx[:, None] + py * hy[:, None]
+    across = -px * hy[:, None] + py * hx[:, None]
+    inside = (np.abs(along) <= 0.5 * cfg.pickup_box_depth) & (np.abs(across) <= 0.5 * cfg.pickup_box_width)
+    ri, bj = np.nonzero(inside)
+    return [(int(free_robots[i]), int(blocks[j])) for i, j in zip(ri, bj)]
+
+
+def attached_wheels(world: GatheringWorld, robots: np.ndarray) -> np.ndarray:
+    """(len(robots), 2) full-power wheel commands steering towards the zone centre."""
+    cfg = world.config
+    cx, cy = cfg.zone_centre
+    pos = world.robot_pos[robots]
+    bearing = np.arctan2(cy - pos[:, 1], cx - pos[:, 0])
+    error = _wrap(bearing - world.robot_angle[robots])
+    backwards = np.abs(error) > 0.5 * math.pi
+    direction = np.where(backwards, -1.0, 1.0)
+    error = np.where(backwards, _wrap(error - math.pi), error)
+    turn = np.clip(2.0 * error / (0.5 * math.pi), -1.0, 1.0)
+    left = direction - turn
+    right = direction + turn
+    scale = np.maximum(np.maximum(np.abs(left), np.abs(right)), 1.0)
+    return np.stack([left / scale, right / scale], axis=1)
+
+
+def avoidance_turns(world: GatheringWorld, wheels: np.ndarray) -> np.ndarray:
+    """Wheel commands with a turn on the spot for free robots facing a near obstacle."""
+    cfg = world.config
+    free = world.robot_attached < 0
+    pos, ang = world.robot_pos, world.robot_angle
+    hx, hy = np.cos(ang), np.sin(ang)
+    reach = cfg.robot_radius + cfg.collision_avoidance_distance
+    dx = pos[None, :, 0] - pos[:, None, 0]
+    dy = pos[None, :, 1] - pos[:, None, 1]
+    along = dx * hx[:, None] + dy * hy[:, None]
+    across = -dx * hy[:, None] + dy * hx[:, None]
+    ahead = (along > 0) & (along < reach + cfg.robot_radius) & (np.abs(across) < 2 * cfg.robot_radius)
+    np.fill_diagonal(ahead, False)
+    robot_side = np.where(ahead, across, 0.0).sum(axis=1)         # > 0: obstacle on the left
+    front_x = pos[:, 0] + reach * hx
+    front_y = pos[:, 1] + reach * hy
+    wall = (front_x < 0) | (front_x > cfg.arena_width) | (front_y < 0) | (front_y > cfg.arena_height)
+    blocked = free & (ahead.any(axis=1) | wall)
+    turn_right = np.where(robot_side > 0, 1.0, np.where(robot_side < 0, -1.0, 1.0))
+    out = wheels.copy()
+    out[blocked, 0] = turn_right[blocked]
+    out[blocked, 1] = -turn_right[blocked]
+    return out
+
+
+def _wrap(angle: np.ndarray) -> np.ndarray:
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi

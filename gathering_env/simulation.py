@@ -1,0 +1,131 @@
+"""One episode of collective gathering as arrays in, arrays out (no dicts, no agent names).
+
+``GatheringSimulation`` is the engine behind the PettingZoo env and the fast path for
+trainers that drive the whole team at once:
+
+    sim = GatheringSimulation(WorldConfig.from_kwargs(environment=2))
+    obs = sim.reset(seed=0, morphology=Morphology.khepera_iii())    # (N, S) float32
+    obs, reward, terminated, truncated = sim.step(wheels)            # wheels: (N, 2)
+
+Step order (SPEC section 2): the controller's wheel commands (computed from the previous
+observation) -> heuristics override them (collision avoidance, attached robots) -> drive
+-> physics step -> pickup -> scoring -> sensing of the new state.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .config import WorldConfig
+from .heuristics import attached_wheels, avoidance_turns, pickup_candidates
+from .scoring import gathered_mask, task_performance
+from .sensing import SensorBank
+from .sensors import Morphology
+from .world import GatheringWorld
+
+
+class GatheringSimulation:
+    """The task's state machine over a ``GatheringWorld``.
+
+    Attributes (after ``reset``):
+        world: the pymunk world. bank: the sensing kernel of the current morphology.
+        steps: steps taken. gathered: (B,) bool blocks wholly inside the zone.
+        gathered_value: sum of the values of gathered blocks (v_c).
+    """
+
+    def __init__(self, config: WorldConfig, morphology: Morphology | None = None) -> None:
+        self.config = config
+        self.morphology = morphology if morphology is not None else Morphology.khepera_iii()
+        self.world = GatheringWorld(config)
+        self.total_value = config.total_value
+        self.steps = 0
+        self.done = True
+
+    def reset(self, seed: int | np.random.Generator | None = None,
+              morphology: Morphology | None = None) -> np.ndarray:
+        """Start a new episode; returns the first observation (N, S) float32."""
+        if morphology is not None:
+            self.morphology = morphology
+        rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+        self.world.reset(rng)
+        w = self.world
+        self.bank = SensorBank(self.morphology, self.config, w.block_half, w.block_need)
+        self.steps = 0
+        self.done = False
+        self.gathered = gathered_mask(w.block_pos, w.block_angle, w.block_half, self.config.zone_rect)
+        self.gathered_value = float(self.world.block_value[self.gathered].sum())
+        return self.observe()
+
+    def observe(self) -> np.ndarray:
+        """Current readings of every robot's sensors, (N, S) float32 in [0, 1]."""
+        w = self.world
+        return self.bank.read(w.robot_pos, w.robot_angle, w.block_pos, w.block_angle)
+
+    def step(self, wheels: np.ndarray) -> tuple[np.ndarray, float, bool, bool]:
+        """Advance one step.
+
+        Args:
+            wheels: (N, 2) finite left/right wheel commands; values outside [-1, 1] are
+                clipped. (Validation of shape and finiteness is the caller's job; the
+                env and ``check_wheels`` do it.)
+
+        Returns:
+            (observation (N, S) float32, team reward, terminated, truncated). The reward is
+            ``100 * (change in gathered value) / total value``, so an episode's rewards sum
+            to the value part of eq. 1.
+        """
+        if self.done:
+            raise RuntimeError("step() called after the episode ended; call reset() first")
+        cfg, w = self.config, self.world
+        wheels = np.clip(wheels, -1.0, 1.0)
+        if cfg.collision_avoidance:
+            wheels = avoidance_turns(w, wheels)
+        attached = np.flatnonzero(w.robot_attached >= 0)
+        if attached.size:
+            wheels[attached] = attached_wheels(w, attached)
+        w.apply_drive(wheels)
+        w.step_physics()
+        self.steps += 1
+
+        gathered = gathered_mask(w.block_pos, w.block_angle, w.block_half, cfg.zone_rect)
+        if cfg.pickup_heuristic:
+            for robot, block in pickup_candidates(w, gathered):
+                if w.robot_attached[robot] < 0:
+                    w.try_attach(robot, block)
+        newly = np.flatnonzero(gathered & ~self.gathered)
+        for block in newly:
+            w.detach_block(int(block))
+        self.gathered = gathered
+        value = float(w.block_value[gathered].sum())
+        reward = 100.0 * (value - self.gathered_value) / self.total_value
+        self.gathered_value = value
+
+        terminated = bool(gathered.all())
+        truncated = (not terminated) and self.steps >= cfg.max_cycles
+        self.done = terminated or truncated
+        return self.observe(), reward, terminated, truncated
+
+    # ------------------------------------------------------------------ statistics
+    def blocks_gathered_by_type(self) -> tuple[int, int, int]:
+        """Gathered blocks per type (small, medium, large)."""
+        counts = np.bincount(self.world.block_type[self.gathered], minlength=3)
+        return (int(counts[0]), int(counts[1]), int(counts[2]))
+
+    def task_performance(self) -> float:
+        """Paper eq. 1 for the episode so far (final once the episode has ended)."""
+        return task_performance(self.gathered_value, self.total_value, self.steps,
+                                self.config.max_cycles, self.config.time_bonus)
+
+
+def check_wheels(wheels: np.ndarray, num_robots: int) -> np.ndarray:
+    """Validate a team action array: shape (num_robots, 2), finite. Returns float64 copy."""
+    arr = np.asarray(wheels, dtype=np.float64)
+    if arr.shape != (num_robots, 2):
+        raise ValueError(f"actions have shape {arr.shape}; expected ({num_robots}, 2) (left, right wheel)")
+    if not np.isfinite(arr).all():
+        bad = np.argwhere(~np.isfinite(arr))[0]
+        raise ValueError(
+            f"action of robot_{bad[0]} is {arr[bad[0]].tolist()}: NaN/inf not allowed; "
+            "allowed: finite values (clipped to [-1, 1])"
+        )
+    return arr

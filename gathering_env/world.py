@@ -1,0 +1,310 @@
+"""The pymunk world: arena walls, robots, blocks, ground friction and attachments.
+
+Top-down 2D without gravity. Ground friction, which pymunk lacks top-down, is modelled
+the usual pymunk way: each block is tied to the static body by a ``PivotJoint`` and a
+``GearJoint`` with ``max_bias = 0`` whose ``max_force``/``max_torque`` equal the friction
+force/torque. A block needing k robots gets the friction ``(k - margin) * F_drive``, so
+k - 1 robots pushing at full drive cannot move it and k robots can.
+
+Each robot is driven through a kinematic *control body* (pymunk's tank example): a pivot
+and a gear joint with ``max_bias = 0`` pull the robot's velocity towards the control
+body's velocity with at most ``robot_drive_force`` / ``robot_drive_torque``. The control
+velocity is the differential-drive velocity along the robot's heading, so the robot has
+no side-slip, brakes when its wheels stop, and can push with at most its drive force.
+
+State is exchanged with pymunk in bulk through ``pymunk.batch`` (one call to read all
+poses, one to set all control velocities); the rest of the package works on the numpy
+arrays ``robot_pos``, ``robot_angle``, ``block_pos`` and ``block_angle``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pymunk
+import pymunk.batch as pbatch
+
+from .config import WorldConfig
+
+_POSE = pbatch.BodyFields.POSITION | pbatch.BodyFields.ANGLE
+_VEL = pbatch.BodyFields.VELOCITY | pbatch.BodyFields.ANGULAR_VELOCITY
+_WALL_RADIUS = 0.5
+
+# Block sides in the block frame: outward normal and tangent of side 0..3 (E, N, W, S).
+_SIDE_NORMALS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
+_SIDE_TANGENTS = np.array([[0.0, 1.0], [-1.0, 0.0], [0.0, -1.0], [1.0, 0.0]])
+
+
+class GatheringWorld:
+    """The physical world of one episode. Call ``reset(rng)`` before use.
+
+    Array state (valid after ``reset`` and after every ``step``):
+        robot_pos (N, 2), robot_angle (N,), block_pos (B, 2), block_angle (B,) in units/rad;
+        block_type (B,) 0/1/2, block_half (B,) half side, block_need (B,), block_value (B,);
+        robot_attached (N,) index of the block a robot is welded to, or -1;
+        block_sticky_side (B,) side (0..3) robots attach to, or -1;
+        anchor_owner (B, 3) robot holding each anchor of the sticky side, or -1.
+    """
+
+    def __init__(self, config: WorldConfig) -> None:
+        self.config = config
+        self.space: pymunk.Space | None = None
+
+    # ------------------------------------------------------------------ construction
+    def reset(self, rng: np.random.Generator) -> None:
+        """Build a fresh world with positions and headings drawn from ``rng``."""
+        cfg = self.config
+        space = pymunk.Space()
+        space.gravity = (0.0, 0.0)
+        space.iterations = cfg.physics_iterations
+        self.space = space
+        self._add_walls()
+
+        types = np.repeat(np.arange(3), cfg.block_counts)
+        self.block_type = types
+        self.block_half = 0.5 * np.asarray(cfg.block_sizes, dtype=float)[types]
+        self.block_need = np.asarray(cfg.robots_needed, dtype=np.int64)[types]
+        self.block_value = np.asarray(cfg.block_values, dtype=float)[types]
+        block_xy, robot_xy = self._place(rng)
+        block_angles = rng.uniform(-math.pi, math.pi, size=len(types))
+        robot_angles = rng.uniform(-math.pi, math.pi, size=cfg.num_robots)
+
+        self.robot_bodies: list[pymunk.Body] = []
+        moment = pymunk.moment_for_circle(cfg.robot_mass, 0.0, cfg.robot_radius)
+        for (x, y), a in zip(robot_xy, robot_angles):
+            body = pymunk.Body(cfg.robot_mass, moment)
+            body.position = (float(x), float(y))
+            body.angle = float(a)
+            shape = pymunk.Circle(body, cfg.robot_radius)
+            shape.friction = cfg.robot_friction
+            space.add(body, shape)
+            self.robot_bodies.append(body)
+
+        self.block_bodies: list[pymunk.Body] = []
+        for t, (x, y), a in zip(types, block_xy, block_angles):
+            size = cfg.block_sizes[t]
+            mass = cfg.block_masses[t]
+            body = pymunk.Body(mass, pymunk.moment_for_box(mass, (size, size)))
+            body.position = (float(x), float(y))
+            body.angle = float(a)
+            shape = pymunk.Poly.create_box(body, (size, size))
+            shape.friction = cfg.block_friction
+            space.add(body, shape)
+            friction = cfg.block_ground_friction(int(t))
+            self._add_ground_friction(body, friction, friction * 0.38 * size)
+            self.block_bodies.append(body)
+
+        self.control_bodies: list[pymunk.Body] = []
+        for body in self.robot_bodies:
+            control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+            control.position = body.position
+            pivot = pymunk.PivotJoint(control, body, (0, 0), (0, 0))
+            pivot.max_bias = 0.0
+            pivot.max_force = cfg.robot_drive_force
+            gear = pymunk.GearJoint(control, body, 0.0, 1.0)
+            gear.max_bias = 0.0
+            gear.max_force = cfg.robot_drive_torque
+            space.add(control, pivot, gear)
+            self.control_bodies.append(control)
+
+        self._index_bodies()
+        n, b = cfg.num_robots, len(types)
+        self.robot_attached = np.full(n, -1, dtype=np.int64)
+        self.block_sticky_side = np.full(b, -1, dtype=np.int64)
+        self.anchor_owner = np.full((b, int(self.block_need.max(initial=1))), -1, dtype=np.int64)
+        self._welds: dict[int, tuple[pymunk.Constraint, pymunk.Constraint]] = {}
+        self.read_state()
+
+    def _add_walls(self) -> None:
+        cfg, r = self.config, _WALL_RADIUS
+        w, h = cfg.arena_width, cfg.arena_height
+        corners = [(-r, -r), (w + r, -r), (w + r, h + r), (-r, h + r)]
+        for a, b in zip(corners, corners[1:] + corners[:1]):
+            seg = pymunk.Segment(self.space.static_body, a, b, r)
+            seg.friction = cfg.robot_friction
+            self.space.add(seg)
+
+    def _add_ground_friction(self, body: pymunk.Body, force: float, torque: float) -> None:
+        pivot = pymunk.PivotJoint(self.space.static_body, body, (0, 0), (0, 0))
+        pivot.max_bias = 0.0
+        pivot.max_force = force
+        gear = pymunk.GearJoint(self.space.static_body, body, 0.0, 1.0)
+        gear.max_bias = 0.0
+        gear.max_force = torque
+        self.space.add(pivot, gear)
+
+    def _place(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """Random non-overlapping positions outside the zone: blocks first, then robots."""
+        cfg = self.config
+        radii = np.concatenate([
+            self.block_half * math.sqrt(2.0),
+            np.full(cfg.num_robots, cfg.robot_radius),
+        ])
+        zx0, zy0, zx1, zy1 = cfg.zone_rect
+        placed = np.zeros((len(radii), 2))
+        gap = 0.05
+        for i, rad in enumerate(radii):
+            margin = rad + gap
+            for _attempt in range(10_000):
+                x = rng.uniform(margin, cfg.arena_width - margin)
+                y = rng.uniform(margin, cfg.arena_height - margin)
+                # keep the whole object outside the zone
+                dx = max(zx0 - x, 0.0, x - zx1)
+                dy = max(zy0 - y, 0.0, y - zy1)
+                if math.hypot(dx, dy) <= margin:
+                    continue
+                if i and np.any(np.hypot(placed[:i, 0] - x, placed[:i, 1] - y) < radii[:i] + margin):
+                    continue
+                placed[i] = (x, y)
+                break
+            else:
+                raise ValueError(
+                    "could not place all robots and blocks without overlap: the arena "
+                    f"({cfg.arena_width} x {cfg.arena_height}) is too small for "
+                    f"{cfg.num_robots} robots and block_counts={cfg.block_counts}"
+                )
+        nb = len(self.block_half)
+        return placed[:nb], placed[nb:]
+
+    def _index_bodies(self) -> None:
+        """Row of every robot, block and control body in pymunk's batch arrays."""
+        buf = pbatch.Buffer()
+        pbatch.get_space_bodies(self.space, pbatch.BodyFields.BODY_ID, buf)
+        ids = np.frombuffer(buf.int_buf(), dtype=np.uintp)
+        row_of = {int(body_id): row for row, body_id in enumerate(ids)}
+        self._robot_rows = np.array([row_of[b.id] for b in self.robot_bodies], dtype=np.intp)
+        self._block_rows = np.array([row_of[b.id] for b in self.block_bodies], dtype=np.intp)
+        self._control_rows = np.array([row_of[b.id] for b in self.control_bodies], dtype=np.intp)
+        self._num_rows = len(ids)
+        self._buf = pbatch.Buffer()
+        self._set_buf = pbatch.Buffer()
+
+    # ------------------------------------------------------------------ stepping
+    def read_state(self) -> None:
+        """Refresh ``robot_pos/angle`` and ``block_pos/angle`` from pymunk (one batch call)."""
+        buf = self._buf
+        buf.clear()
+        pbatch.get_space_bodies(self.space, _POSE, buf)
+        poses = np.frombuffer(buf.float_buf(), dtype=np.float64).reshape(self._num_rows, 3)
+        robots = poses[self._robot_rows]
+        blocks = poses[self._block_rows]
+        self.robot_pos = robots[:, :2]
+        self.robot_angle = robots[:, 2]
+        self.block_pos = blocks[:, :2]
+        self.block_angle = blocks[:, 2]
+
+    def apply_drive(self, wheels: np.ndarray) -> None:
+        """Set each robot's wheel drive for the next physics step.
+
+        Args:
+            wheels: (N, 2) left/right wheel commands in [-1, 1] (fraction of top speed).
+        """
+        cfg = self.config
+        v_left = wheels[:, 0] * cfg.robot_max_speed
+        v_right = wheels[:, 1] * cfg.robot_max_speed
+        forward = 0.5 * (v_left + v_right)
+        spin = (v_right - v_left) / (2.0 * cfg.robot_radius)
+        buf = self._buf
+        buf.clear()
+        pbatch.get_space_bodies(self.space, _VEL, buf)
+        vel = np.frombuffer(buf.float_buf(), dtype=np.float64).reshape(self._num_rows, 3).copy()
+        rows = self._control_rows
+        vel[rows, 0] = forward * np.cos(self.robot_angle)
+        vel[rows, 1] = forward * np.sin(self.robot_angle)
+        vel[rows, 2] = spin
+        self._set_buf.set_float_buf(vel.tobytes())
+        pbatch.set_space_bodies(self.space, _VEL, self._set_buf)
+
+    def step_physics(self) -> None:
+        """Advance pymunk by ``dt`` and refresh the array state."""
+        self.space.step(self.config.dt)
+        self.read_state()
+
+    def place_robot(self, robot: int, x: float, y: float, angle: float) -> None:
+        """Move a robot to (x, y) with heading ``angle`` at rest (scripted scenes, tests)."""
+        self._place_body(self.robot_bodies[robot], x, y, angle)
+        self.control_bodies[robot].position = (float(x), float(y))
+
+    def place_block(self, block: int, x: float, y: float, angle: float) -> None:
+        """Move a block to (x, y) with rotation ``angle`` at rest (scripted scenes, tests)."""
+        self._place_body(self.block_bodies[block], x, y, angle)
+
+    def _place_body(self, body: pymunk.Body, x: float, y: float, angle: float) -> None:
+        values = (float(x), float(y), float(angle))
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"pose {values} must be finite")
+        body.position = values[:2]
+        body.angle = values[2]
+        body.velocity = (0.0, 0.0)
+        body.angular_velocity = 0.0
+        self.space.reindex_shapes_for_body(body)
+        self.read_state()
+
+    # ------------------------------------------------------------------ attachments
+    def anchor_points(self, block: int, side: int) -> np.ndarray:
+        """(k, 2) world positions of the k anchor points on one side of a block."""
+        k = int(self.block_need[block])
+        half = self.block_half[block]
+        offsets = ((np.arange(k) + 0.5) / k * 2.0 - 1.0) * half
+        local = _SIDE_NORMALS[side] * half + offsets[:, None] * _SIDE_TANGENTS[side]
+        c, s = math.cos(self.block_angle[block]), math.sin(self.block_angle[block])
+        rot = np.array([[c, -s], [s, c]])
+        return self.block_pos[block] + local @ rot.T
+
+    def try_attach(self, robot: int, block: int) -> bool:
+        """Weld ``robot`` to the nearest free anchor of ``block`` if one is within reach.
+
+        The first robot fixes the block's sticky side; later ones may only use that side.
+        Returns True if the robot was attached.
+        """
+        cfg = self.config
+        heading = np.array([math.cos(self.robot_angle[robot]), math.sin(self.robot_angle[robot])])
+        front = self.robot_pos[robot] + cfg.robot_radius * heading
+        sticky = int(self.block_sticky_side[block])
+        sides = range(4) if sticky < 0 else (sticky,)
+        best = None
+        for side in sides:
+            points = self.anchor_points(block, side)
+            for slot, point in enumerate(points):
+                if sticky >= 0 and self.anchor_owner[block, slot] >= 0:
+                    continue
+                dist = float(np.hypot(*(point - front)))
+                if best is None or dist < best[0]:
+                    best = (dist, side, slot, point)
+        if best is None or best[0] > cfg.pickup_reach * cfg.robot_radius:
+            return False
+        _, side, slot, point = best
+        robot_body = self.robot_bodies[robot]
+        block_body = self.block_bodies[block]
+        if cfg.pickup_positioning:
+            normal_angle = self.block_angle[block] + math.atan2(*_SIDE_NORMALS[side][::-1])
+            outward = np.array([math.cos(normal_angle), math.sin(normal_angle)])
+            robot_body.position = tuple(point + outward * cfg.robot_radius)
+            robot_body.angle = normal_angle + math.pi
+            robot_body.velocity = (0.0, 0.0)
+            robot_body.angular_velocity = 0.0
+            self.space.reindex_shapes_for_body(robot_body)
+            weld_point = tuple(point)
+        else:
+            weld_point = tuple(front)
+        pivot = pymunk.PivotJoint(robot_body, block_body, weld_point)
+        pivot.collide_bodies = False
+        gear = pymunk.GearJoint(robot_body, block_body, block_body.angle - robot_body.angle, 1.0)
+        gear.collide_bodies = False
+        self.space.add(pivot, gear)
+        self._welds[robot] = (pivot, gear)
+        self.block_sticky_side[block] = side
+        self.anchor_owner[block, slot] = robot
+        self.robot_attached[robot] = block
+        if cfg.pickup_positioning:
+            self.read_state()
+        return True
+
+    def detach_block(self, block: int) -> None:
+        """Release every robot welded to ``block`` and clear its sticky side."""
+        for robot in np.flatnonzero(self.robot_attached == block):
+            self.space.remove(*self._welds.pop(int(robot)))
+            self.robot_attached[robot] = -1
+        self.anchor_owner[block] = -1
+        self.block_sticky_side[block] = -1
