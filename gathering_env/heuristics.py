@@ -37,26 +37,34 @@ def pickup_candidates(world: GatheringWorld, gathered: np.ndarray) -> list[tuple
     blocks = np.flatnonzero(open_blocks)
     if blocks.size == 0:
         return []
+    # Cheap prefilter on centre distances; the exact box test runs on the few survivors.
+    reach = cfg.robot_radius + cfg.pickup_box_depth + 0.5 * cfg.pickup_box_width
+    reach = reach + world.block_half[blocks] * math.sqrt(2.0)
+    dx = world.block_pos[blocks, 0] - world.robot_pos[free_robots, 0:1]
+    dy = world.block_pos[blocks, 1] - world.robot_pos[free_robots, 1:2]
+    near_r, near_b = np.nonzero(dx * dx + dy * dy <= reach * reach)
+    if near_r.size == 0:
+        return []
+    free_robots, blocks = free_robots[near_r], blocks[near_b]       # candidate pairs
     pos = world.robot_pos[free_robots]
     ang = world.robot_angle[free_robots]
     hx, hy = np.cos(ang), np.sin(ang)
     centre_offset = cfg.robot_radius + 0.5 * cfg.pickup_box_depth
-    box_x = pos[:, 0] + centre_offset * hx                         # (R,)
+    box_x = pos[:, 0] + centre_offset * hx                         # (P,)
     box_y = pos[:, 1] + centre_offset * hy
     # Nearest block point to the box centre, per (robot, block).
     cb, sb = np.cos(world.block_angle[blocks]), np.sin(world.block_angle[blocks])
     half = world.block_half[blocks]
-    rx = box_x[:, None] - world.block_pos[blocks, 0]
-    ry = box_y[:, None] - world.block_pos[blocks, 1]
+    rx = box_x - world.block_pos[blocks, 0]
+    ry = box_y - world.block_pos[blocks, 1]
     lx = np.clip(rx * cb + ry * sb, -half, half)
     ly = np.clip(-rx * sb + ry * cb, -half, half)
-    px = world.block_pos[blocks, 0] + lx * cb - ly * sb - box_x[:, None]
-    py = world.block_pos[blocks, 1] + lx * sb + ly * cb - box_y[:, None]
-    along = px * hx[:, None] + py * hy[:, None]
-    across = -px * hy[:, None] + py * hx[:, None]
+    px = world.block_pos[blocks, 0] + lx * cb - ly * sb - box_x
+    py = world.block_pos[blocks, 1] + lx * sb + ly * cb - box_y
+    along = px * hx + py * hy
+    across = -px * hy + py * hx
     inside = (np.abs(along) <= 0.5 * cfg.pickup_box_depth) & (np.abs(across) <= 0.5 * cfg.pickup_box_width)
-    ri, bj = np.nonzero(inside)
-    return [(int(free_robots[i]), int(blocks[j])) for i, j in zip(ri, bj)]
+    return [(int(r), int(b)) for r, b in zip(free_robots[inside], blocks[inside])]
 
 
 def attached_wheels(world: GatheringWorld, robots: np.ndarray) -> np.ndarray:

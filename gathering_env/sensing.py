@@ -36,6 +36,7 @@ IR, US, COLOUR, CAMERA, BOTTOM = (TYPE_CODES[t] for t in ("infrared", "ultrasoni
 
 # Outward normals of the four arena walls: west, east, south, north.
 _WALL_NORMALS = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, -1.0], [0.0, 1.0]])
+_WALL_TANGENTS = _WALL_NORMALS[:, ::-1].copy()
 
 
 class SensorBank:
@@ -77,6 +78,26 @@ class SensorBank:
         self._offset_c = self.axis_offset[self._cone_idx]
         self._bearing_c = self.bearing[self._cone_idx]
         self._has_cone = self._cone_idx.size > 0
+        # Inward distance of a point p to wall w is offset_w - normal_w . p (>= 0 inside).
+        self._wall_offset = np.array([0.0, config.arena_width, 0.0, config.arena_height])
+        self._cos_half_w = self._cos_half_c[None, :, None]
+        self._sin_half_w = self._sin_half_c[None, :, None]
+
+        # Object list for the cone kernel: N robots (discs) then B blocks (squares).
+        n = config.num_robots
+        r = config.robot_radius
+        self._ones_n, self._zeros_n = np.ones(n), np.zeros(n)
+        self._obj_half = np.concatenate([np.zeros(n), self.block_half])
+        self._obj_radius = np.concatenate([np.full(n, r), np.zeros(self.block_half.size)])
+        self._obj_is_robot = np.concatenate([np.ones(n, bool), np.zeros(self.block_half.size, bool)])
+        self._obj_need = np.concatenate([np.zeros(n), self.block_needs])
+        # Squared centre distance below which some sensor of a robot may see an object:
+        # mount offset r + longest range + the object's circumradius. Self pairs: -1.
+        max_range = float(self._range_c.max(initial=0.0))
+        bound = self._obj_radius + self._obj_half * np.sqrt(2.0)
+        reach = (r + max_range + bound + 1e-9) ** 2
+        self._reach_sq = np.broadcast_to(reach, (n, reach.size)).copy()
+        self._reach_sq[np.arange(n), np.arange(n)] = -1.0
 
     # ------------------------------------------------------------------------------
     def read(self, robot_pos: np.ndarray, robot_angle: np.ndarray,
@@ -106,85 +127,94 @@ class SensorBank:
         return np.clip(1.0 - outside / self.config.bottom_falloff, 0.0, 1.0)
 
     def _read_cones(self, robot_pos, robot_angle, block_pos, block_angle) -> np.ndarray:
+        """(N, C) readings of the cone sensors.
+
+        Robots and blocks form one object list (robots = discs of radius r, blocks =
+        squares). A cheap (N, K) centre-distance test keeps only the (robot, object)
+        pairs some sensor could reach; the exact nearest-point and cone geometry is then
+        evaluated on those P pairs x C sensors and reduced per robot with ``reduceat``.
+        """
         cfg = self.config
+        n = robot_pos.shape[0]
         r = cfg.robot_radius
-        rng = self._range_c                                   # (C,)
-        cos_half = self._cos_half_c
-        mount_angle = robot_angle[:, None] + self._bearing_c  # (N, C)
-        mx = robot_pos[:, 0:1] + r * np.cos(mount_angle)       # (N, C)
+        rng = self._range_c                                    # (C,)
+        mount_angle = robot_angle[:, None] + self._bearing_c   # (N, C)
+        mx = robot_pos[:, 0:1] + r * np.cos(mount_angle)
         my = robot_pos[:, 1:2] + r * np.sin(mount_angle)
         axis = robot_angle[:, None] + self._offset_c
-        hx, hy = np.cos(axis), np.sin(axis)                   # (N, C)
+        hx, hy = np.cos(axis), np.sin(axis)
 
-        # --- robots: discs; the nearest point lies along the line to the centre -----
-        dx = robot_pos[None, None, :, 0] - mx[:, :, None]     # (N, C, N)
-        dy = robot_pos[None, None, :, 1] - my[:, :, None]
-        centre_dist = np.sqrt(dx * dx + dy * dy)
-        dist_r = np.maximum(centre_dist - r, 0.0)
-        seen_r = (dx * hx[:, :, None] + dy * hy[:, :, None]) >= centre_dist * cos_half[None, :, None]
-        seen_r &= dist_r < rng[None, :, None]
-        idx = np.arange(robot_pos.shape[0])
-        seen_r[idx, :, idx] = False                           # a robot never sees itself
-        d_robot = np.where(seen_r, dist_r, np.inf).min(axis=2)  # (N, C)
+        obj_pos = np.concatenate([robot_pos, block_pos])       # (K, 2)
+        obj_cos = np.concatenate([self._ones_n, np.cos(block_angle)])
+        obj_sin = np.concatenate([self._zeros_n, np.sin(block_angle)])
 
-        # --- blocks: squares; nearest point by clamping in the block frame ----------
-        if block_pos.shape[0]:
-            cb, sb = np.cos(block_angle), np.sin(block_angle)     # (B,)
-            rx = mx[:, :, None] - block_pos[None, None, :, 0]     # (N, C, B)
-            ry = my[:, :, None] - block_pos[None, None, :, 1]
-            lx = rx * cb + ry * sb                                # mount in the block frame
-            ly = -rx * sb + ry * cb
-            half = self.block_half
-            vx = np.clip(lx, -half, half) - lx                    # mount -> nearest point
-            vy = np.clip(ly, -half, half) - ly
-            wx = vx * cb - vy * sb                                # back to the world frame
-            wy = vx * sb + vy * cb
-            dist_b = np.sqrt(wx * wx + wy * wy)
-            seen_b = (wx * hx[:, :, None] + wy * hy[:, :, None]) >= dist_b * cos_half[None, :, None]
-            seen_b &= dist_b < rng[None, :, None]
-            d_block = np.where(seen_b, dist_b, np.inf).min(axis=2)
-        else:
-            seen_b = np.zeros(mx.shape + (0,), dtype=bool)
-            d_block = np.full(mx.shape, np.inf)
+        # --- candidate pairs: centre distance within reach of the longest sensor -----
+        cdx = obj_pos[None, :, 0] - robot_pos[:, 0:1]          # (N, K)
+        cdy = obj_pos[None, :, 1] - robot_pos[:, 1:2]
+        near = cdx * cdx + cdy * cdy < self._reach_sq          # self excluded via reach_sq
+        ii, kk = np.nonzero(near)
 
-        readings = np.zeros(mx.shape)
+        d_robot = np.full((n, rng.size), np.inf)
+        d_block = np.full((n, rng.size), np.inf)
+        robots_seen = np.zeros((n, rng.size))
+        need_seen = np.zeros((n, rng.size))
+        if ii.size:
+            # mount relative to the object centre, in the object's frame
+            c, s = obj_cos[kk, None], obj_sin[kk, None]         # (P, 1)
+            rx = mx[ii] - obj_pos[kk, 0:1]                     # (P, C)
+            ry = my[ii] - obj_pos[kk, 1:2]
+            lx = rx * c + ry * s
+            ly = ry * c - rx * s
+            half = self._obj_half[kk, None]
+            vx = np.minimum(np.maximum(lx, -half), half) - lx  # mount -> nearest point
+            vy = np.minimum(np.maximum(ly, -half), half) - ly
+            hxi, hyi = hx[ii], hy[ii]
+            dot = vx * (hxi * c + hyi * s) + vy * (hyi * c - hxi * s)
+            centre = np.sqrt(vx * vx + vy * vy)
+            dist = np.maximum(centre - self._obj_radius[kk, None], 0.0)
+            seen = (dot >= centre * self._cos_half_c) & (dist < rng)
+            is_robot = self._obj_is_robot[kk, None]
+            starts = np.flatnonzero(np.concatenate(([True], ii[1:] != ii[:-1])))
+            rows = ii[starts]
+            d_robot[rows] = np.minimum.reduceat(np.where(seen & is_robot, dist, np.inf), starts)
+            d_block[rows] = np.minimum.reduceat(np.where(seen & ~is_robot, dist, np.inf), starts)
+            if self._needs_camera:
+                robots_seen[rows] = np.add.reduceat(seen & is_robot, starts)
+                need_seen[rows] = np.add.reduceat(np.where(seen, self._obj_need[kk, None], 0.0), starts)
+
+        readings = np.zeros((n, rng.size))
         if self._needs_walls:
             d_wall = self._wall_distance(mx, my, hx, hy)
             d_any = np.minimum(np.minimum(d_robot, d_block), d_wall)
             closeness = np.where(d_any < rng, 1.0 - d_any * self._inv_range_c, 0.0)  # (N, C)
-            if cfg.ir_response == "gamma":
-                ir = closeness ** cfg.ir_gamma
-            else:
-                ir = closeness
+            ir = closeness ** cfg.ir_gamma if cfg.ir_response == "gamma" else closeness
             readings = np.where(self._is[IR], ir, readings)
-            us = np.clip(closeness / 0.95, 0.0, 1.0)
-            readings = np.where(self._is[US], us, readings)
+            readings = np.where(self._is[US], np.minimum(closeness / 0.95, 1.0), readings)
             colour = np.where(d_block <= d_any, 0.5 + 0.5 * closeness,
                               np.where((d_wall <= d_any) & (d_robot > d_any), 0.5 * closeness, 0.0))
-            colour = np.where(d_any < rng, colour, 0.0)
-            readings = np.where(self._is[COLOUR], colour, readings)
+            readings = np.where(self._is[COLOUR] & (d_any < rng), colour, readings)
         if self._needs_camera:
-            robots_seen = seen_r.sum(axis=2) + 1.0
-            need_seen = seen_b @ self.block_needs if seen_b.shape[2] else np.zeros(mx.shape)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                camera = np.where((need_seen > 0) & (robots_seen <= need_seen),
-                                  robots_seen / np.where(need_seen > 0, need_seen, 1.0), 0.0)
+            team = robots_seen + 1.0
+            ok = (need_seen > 0) & (team <= need_seen)
+            camera = np.where(ok, team / np.where(ok, need_seen, 1.0), 0.0)
             readings = np.where(self._is[CAMERA], camera, readings)
         return readings
 
     def _wall_distance(self, mx, my, hx, hy) -> np.ndarray:
-        """Distance (N, C) to the nearest wall point inside each cone, inf if none."""
+        """Distance (N, C) to the nearest wall point inside each cone, inf if none.
+
+        For a wall with inward distance ``perp`` whose outward normal makes the angle
+        ``delta`` with the sensor axis, the nearest wall point inside a cone of half-angle
+        ``a`` lies at ``perp / cos(max(delta - a, 0))`` (visible while that angle < 90 deg).
+        """
         cfg = self.config
-        perp = np.stack([mx, cfg.arena_width - mx, my, cfg.arena_height - my], axis=-1)  # (N, C, 4)
-        cos_d = hx[..., None] * _WALL_NORMALS[:, 0] + hy[..., None] * _WALL_NORMALS[:, 1]
-        sin_d = np.abs(hx[..., None] * _WALL_NORMALS[:, 1] - hy[..., None] * _WALL_NORMALS[:, 0])
-        cos_half = self._cos_half_c[None, :, None]
-        sin_half = self._sin_half_c[None, :, None]
-        # Angle between the wall normal and the nearest cone direction: 0 when the
-        # normal is inside the cone, else (delta - half_fov).
-        cos_eff = np.where(cos_d >= cos_half, 1.0, cos_d * cos_half + sin_d * sin_half)
-        with np.errstate(divide="ignore"):
-            dist = np.where(cos_eff > 1e-9, np.maximum(perp, 0.0) / np.maximum(cos_eff, 1e-9), np.inf)
+        heading = np.stack((hx, hy), axis=-1)                            # (N, C, 2)
+        cos_d = heading @ _WALL_NORMALS.T                                 # (N, C, 4)
+        sin_d = np.abs(heading @ _WALL_TANGENTS.T)
+        perp = self._wall_offset - np.stack((mx, my), axis=-1) @ _WALL_NORMALS.T
+        cos_eff = np.where(cos_d >= self._cos_half_w, 1.0, cos_d * self._cos_half_w + sin_d * self._sin_half_w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dist = np.where(cos_eff > 1e-9, perp / cos_eff, np.inf)
         return dist.min(axis=-1)
 
 
