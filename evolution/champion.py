@@ -1,0 +1,139 @@
+"""Champion files: a genome's decoded team as plain JSON (no pickle needed to load).
+
+A champion file holds the decoded morphology and controller weights (enough to replay the
+team), the objectives it reached, the environment it was evolved in, and the genome's
+genes as plain data::
+
+    {"format": "gathering-evolution/champion", "version": 1,
+     "method": "hyperneat-m", "experiment": "S2", "generation": 41, "genome_key": 6130,
+     "objectives": {"task": 57.3, "morphology": 61.0, "controller": 82.0},
+     "environment": {"environment": 2, "max_cycles": 10000},
+     "morphology": {"sensors": [...]}, "controller": {...}, "genome": {...}}
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from gathering_env import Morphology
+
+from .checkpoint import atomic_write_bytes
+
+FORMAT = "gathering-evolution/champion"
+VERSION = 1
+
+
+class ChampionError(ValueError):
+    """A champion file that is missing, truncated, malformed or of another version."""
+
+
+def genome_to_dict(genome: Any) -> dict[str, Any]:
+    """Plain-data view of a neat-python genome: nodes, connections and any extra genes."""
+    def gene_data(gene: Any) -> dict[str, Any]:
+        data = {}
+        for attr in getattr(gene, "_gene_attributes", ()):
+            value = getattr(gene, attr.name)
+            data[attr.name] = _plain(value)
+        return data
+
+    out: dict[str, Any] = {
+        "key": genome.key,
+        "nodes": {str(k): gene_data(g) for k, g in sorted(genome.nodes.items())},
+        "connections": [
+            {"in": k[0], "out": k[1], **gene_data(g)} for k, g in sorted(genome.connections.items())
+        ],
+    }
+    sensors = getattr(genome, "sensors", None)
+    if sensors is not None:
+        items = sensors.items() if isinstance(sensors, dict) else enumerate(sensors)
+        out["sensors"] = {str(k): _plain(getattr(s, "to_dict", lambda s=s: vars(s))()) for k, s in items}
+    return out
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, (str, int, float, bool)) or value is None:
+        return value
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if hasattr(value, "item"):
+        return value.item()
+    return str(value)
+
+
+@dataclass
+class Champion:
+    """A loaded champion: everything needed to replay the team."""
+
+    method: str
+    morphology: Morphology
+    controller: Any
+    objectives: dict[str, float]
+    environment: dict[str, Any]
+    experiment: str = ""
+    generation: int = -1
+    genome_key: int = -1
+    genome: dict[str, Any] | None = None
+
+
+def save_champion(path: Path, *, method: str, experiment: str, generation: int, genome: Any,
+                  morphology: Morphology, controller: Any, objectives: dict[str, float],
+                  environment: dict[str, Any]) -> Path:
+    """Write a champion JSON file atomically; returns its path."""
+    doc = {
+        "format": FORMAT,
+        "version": VERSION,
+        "method": method,
+        "experiment": experiment,
+        "generation": int(generation),
+        "genome_key": int(genome.key),
+        "objectives": {k: float(v) for k, v in objectives.items()},
+        "environment": _plain(environment),
+        "morphology": morphology.to_dict(),
+        "controller": controller.to_dict(),
+        "genome": genome_to_dict(genome),
+    }
+    path = Path(path)
+    atomic_write_bytes(path, (json.dumps(doc, indent=1, allow_nan=False) + "\n").encode())
+    return path
+
+
+def load_champion(path: str | Path) -> Champion:
+    """Read a champion file. Raises ``ChampionError`` naming the file and the field."""
+    from .controller import TeamController
+
+    path = Path(path)
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ChampionError(f"{path}: champion file not found") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as err:
+        raise ChampionError(f"{path}: not valid JSON (truncated?): {err}") from None
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        raise ChampionError(f"{path}: field 'format' must be {FORMAT!r}")
+    if doc.get("version") != VERSION:
+        raise ChampionError(f"{path}: field 'version' is {doc.get('version')!r}; this package reads {VERSION}")
+    for key in ("method", "morphology", "controller", "objectives", "environment"):
+        if key not in doc:
+            raise ChampionError(f"{path}: field {key!r} is missing")
+    try:
+        morphology = Morphology.from_dict(doc["morphology"])
+    except ValueError as err:
+        raise ChampionError(f"{path}: field 'morphology': {err}") from None
+    try:
+        controller = TeamController.from_dict(doc["controller"])
+    except (ValueError, KeyError, TypeError) as err:
+        raise ChampionError(f"{path}: field 'controller': {err}") from None
+    return Champion(
+        method=doc["method"], morphology=morphology, controller=controller,
+        objectives=dict(doc["objectives"]), environment=dict(doc["environment"]),
+        experiment=doc.get("experiment", ""), generation=int(doc.get("generation", -1)),
+        genome_key=int(doc.get("genome_key", -1)), genome=doc.get("genome"),
+    )

@@ -1,0 +1,118 @@
+"""Command-line entry points: ``gathering-evolve`` and ``gathering-replay``.
+
+Errors in input files (experiment TOML, neat config, checkpoint, champion) end with a
+one-line message naming the file and field and exit status 2; nothing already written is
+touched.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from .checkpoint import CheckpointError
+from .experiment import METHODS, ExperimentError, load_experiment
+
+
+def _fail(message: str) -> int:
+    print(f"error: {message}", file=sys.stderr)
+    return 2
+
+
+def evolve_main(argv: list[str] | None = None) -> int:
+    """``gathering-evolve [EXPERIMENT.toml] [overrides] --out RUN_DIR``."""
+    parser = argparse.ArgumentParser(
+        prog="gathering-evolve",
+        description="Co-evolve controllers and sensor morphologies of a robot team (HyperNEAT-M / NEAT-M).",
+    )
+    parser.add_argument("experiment", nargs="?", type=Path,
+                        help="TOML experiment file (default: built-in paper defaults; see configs/)")
+    parser.add_argument("--out", type=Path, help="run directory (default: runs/<name>-seed<seed>)")
+    parser.add_argument("--workers", type=int, default=None, help="evaluation processes (default: all cores; 1 = serial)")
+    parser.add_argument("--resume", action="store_true", help="continue the run in --out from its newest checkpoint")
+    parser.add_argument("--resume-from", type=Path, help="continue from this checkpoint file")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    group = parser.add_argument_group("overrides of the experiment file")
+    group.add_argument("--name")
+    group.add_argument("--method", choices=METHODS)
+    group.add_argument("--objectives", help="comma-separated: task,morphology,controller")
+    group.add_argument("--seed", type=int)
+    group.add_argument("--generations", type=int)
+    group.add_argument("--population", type=int)
+    group.add_argument("--trials", type=int)
+    group.add_argument("--environment", type=int, help="environment preset 1, 2 or 3")
+    group.add_argument("--steps", type=int, help="steps per trial (max_cycles)")
+    group.add_argument("--robots", type=int, help="team size (num_robots)")
+    args = parser.parse_args(argv)
+
+    overrides = {
+        "name": args.name, "method": args.method, "seed": args.seed, "generations": args.generations,
+        "population": args.population, "trials": args.trials,
+        "objectives": args.objectives.split(",") if args.objectives else None,
+        "environment.environment": args.environment, "environment.max_cycles": args.steps,
+        "environment.num_robots": args.robots,
+    }
+    if args.workers is not None and args.workers < 1:
+        return _fail(f"--workers={args.workers}; allowed: >= 1")
+    try:
+        experiment = load_experiment(args.experiment, overrides)
+        out = args.out or Path("runs") / f"{experiment.name}-seed{experiment.seed}"
+        from .trainer import Trainer
+
+        trainer = Trainer(experiment, out, workers=args.workers, resume=args.resume,
+                          resume_from=args.resume_from, progress=not args.no_progress)
+        result = trainer.run()
+    except (ExperimentError, CheckpointError) as err:
+        return _fail(str(err))
+    except KeyboardInterrupt:
+        print("\ninterrupted: resume with --resume", file=sys.stderr)
+        return 130
+    status = "converged" if result.converged else "finished"
+    print(f"{status}: {result.generations} generations, best ft {result.best_task:.2f}")
+    print(f"run directory: {result.run_dir}  (stats.jsonl, stats.csv, stats.png, champion.json, checkpoints/)")
+    return 0
+
+
+def replay_main(argv: list[str] | None = None) -> int:
+    """``gathering-replay CHAMPION.json [--environment N] [--out team.gif]``."""
+    parser = argparse.ArgumentParser(prog="gathering-replay",
+                                     description="Replay an evolved team and save the episode as GIF/MP4.")
+    parser.add_argument("champion", type=Path, help="champion JSON written by gathering-evolve")
+    parser.add_argument("--environment", type=int, choices=(1, 2, 3), help="preset (default: the one it evolved in)")
+    parser.add_argument("--steps", type=int, help="episode length (default: the evolved max_cycles)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path, default=Path("team.gif"), help=".gif or .mp4")
+    parser.add_argument("--frame-every", type=int, default=10, help="record every k-th step")
+    parser.add_argument("--fps", type=int, default=15)
+    args = parser.parse_args(argv)
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    from .champion import ChampionError, load_champion
+    from .replay import replay
+
+    try:
+        champion = load_champion(args.champion)
+        env_config = dict(champion.environment)
+        if args.environment is not None:
+            env_config["environment"] = args.environment
+        if args.steps is not None:
+            env_config["max_cycles"] = args.steps
+        info, path, frames = replay(champion, env_config, args.seed, args.out, args.frame_every, args.fps)
+    except ChampionError as err:
+        return _fail(str(err))
+    except ValueError as err:
+        return _fail(str(err))
+    print(f"{champion.experiment or 'champion'} ({champion.method}, {len(champion.morphology)} sensors) in "
+          f"environment {env_config.get('environment')}: ft = {info['task_performance']:.2f}, gathered "
+          f"{info['gathered_value']:.0f}/{info['total_value']:.0f} in {info['steps']} steps")
+    print(f"wrote {path} ({frames} frames)")
+    return 0
+
+
+def run_evolve() -> None:
+    sys.exit(evolve_main())
+
+
+def run_replay() -> None:
+    sys.exit(replay_main())

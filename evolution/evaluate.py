@@ -1,0 +1,141 @@
+"""Evaluate one genome: decode it, run its team for several trials, return its objectives.
+
+The environment is used only through its public API: ``parallel_env(**env_config)``,
+``reset(seed=..., options={"morphology": ...})`` and the dict-free ``step_batch``.
+
+Trial seeds are derived from (run seed, generation, trial index) only, so every genome of
+a generation meets the same worlds and a result does not depend on which process ran it.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from gathering_env import Morphology, SENSOR_TYPES, morphological_complexity, parallel_env
+
+_ENV_CACHE: dict[str, Any] = {}
+
+
+def trial_seed(run_seed: int, generation: int, trial: int) -> int:
+    """The episode seed of ``trial`` in ``generation`` of a run (a 32-bit integer)."""
+    return int(np.random.SeedSequence([int(run_seed), int(generation), int(trial)]).generate_state(1)[0])
+
+
+def decode_genome(method: str, genome: Any, config: Any, substrate: Any = None):
+    """(TeamController, Morphology) of a genome for the given method."""
+    if method == "hyperneat-m":
+        from .substrate import Substrate, decode
+
+        return decode(genome, config, substrate if substrate is not None else Substrate())
+    if method == "neat-m":
+        from .direct import decode_neat_m
+
+        return decode_neat_m(genome, config)
+    raise ValueError(f"method={method!r}; allowed: 'hyperneat-m', 'neat-m'")
+
+
+def sensor_statistics(morphology: Morphology) -> dict[str, float]:
+    """Flat per-type statistics: ``count_<type>``, ``range_<type>``, ``fov_<type>`` (means, NaN if absent)."""
+    stats: dict[str, float] = {"num_sensors": float(len(morphology))}
+    for kind in SENSOR_TYPES:
+        members = [s for s in morphology if s.type == kind]
+        stats[f"count_{kind}"] = float(len(members))
+        if SENSOR_TYPES[kind].configurable:
+            stats[f"range_{kind}"] = float(np.mean([s.range for s in members])) if members else float("nan")
+            stats[f"fov_{kind}"] = float(np.mean([s.fov for s in members])) if members else float("nan")
+    return stats
+
+
+@dataclass
+class Evaluation:
+    """Outcome of one genome's trials. All objectives are to be maximised."""
+
+    task: float
+    """Mean task performance ft over the trials (paper eq. 1)."""
+    morphology: float
+    """Morphological simplicity C (paper eq. 2)."""
+    controller: float
+    """Controller simplicity, 100 - number of links (the original's definition)."""
+    trial_ft: list[float] = field(default_factory=list)
+    sensors: dict[str, float] = field(default_factory=dict)
+    steps: int = 0
+    seconds_env: float = 0.0
+    seconds_controller: float = 0.0
+    seconds_decode: float = 0.0
+
+    def objectives(self, names: tuple[str, ...]) -> tuple[float, ...]:
+        return tuple(float(getattr(self, n)) for n in names)
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def _env_for(env_config: dict[str, Any]):
+    key = repr(sorted(env_config.items()))
+    env = _ENV_CACHE.get(key)
+    if env is None:
+        env = parallel_env(**env_config)
+        _ENV_CACHE.clear()  # one live world per process
+        _ENV_CACHE[key] = env
+    return env
+
+
+def run_team(env, controller, morphology: Morphology, seed: int) -> tuple[float, int, float, float]:
+    """One episode of a team. Returns (ft, steps, seconds in env, seconds in controller)."""
+    obs_dict, _ = env.reset(seed=seed, options={"morphology": morphology})
+    obs = np.stack([obs_dict[a] for a in env.possible_agents])
+    t_env = t_ctrl = 0.0
+    steps = 0
+    clock = time.perf_counter
+    while True:
+        t0 = clock()
+        wheels = controller.act(obs)
+        t1 = clock()
+        obs, _, terminated, truncated = env.step_batch(wheels)
+        t_env += clock() - t1
+        t_ctrl += t1 - t0
+        steps += 1
+        if terminated or truncated:
+            break
+    return float(env.team_info()["task_performance"]), steps, t_env, t_ctrl
+
+
+def evaluate(genome: Any, config: Any, env_config: dict[str, Any], trials: int = 5, seed: int = 0,
+             generation: int = 0, method: str = "hyperneat-m", substrate: Any = None) -> Evaluation:
+    """Decode ``genome`` and run its team for ``trials`` episodes.
+
+    Args:
+        genome: a neat-python genome of the method's genome class. config: its ``neat.Config``.
+        env_config: keyword arguments of ``gathering_env.parallel_env``.
+        trials: episodes; the task objective is the mean ft. seed: the run seed.
+        generation: used with ``seed`` to derive the trial seeds.
+
+    Returns:
+        An ``Evaluation`` with the three objectives, per-trial ft and sensor statistics.
+    """
+    t0 = time.perf_counter()
+    controller, morphology = decode_genome(method, genome, config, substrate)
+    t_decode = time.perf_counter() - t0
+    env = _env_for(env_config)
+    fts, total_steps, t_env, t_ctrl = [], 0, 0.0, 0.0
+    for trial in range(trials):
+        ft, steps, te, tc = run_team(env, controller, morphology, trial_seed(seed, generation, trial))
+        fts.append(ft)
+        total_steps += steps
+        t_env += te
+        t_ctrl += tc
+    return Evaluation(
+        task=float(np.mean(fts)),
+        morphology=morphological_complexity(morphology),
+        controller=100.0 - float(controller.num_links),
+        trial_ft=fts,
+        sensors=sensor_statistics(morphology),
+        steps=total_steps,
+        seconds_env=t_env,
+        seconds_controller=t_ctrl,
+        seconds_decode=t_decode,
+    )

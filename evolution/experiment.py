@@ -1,0 +1,184 @@
+"""Experiment files: one TOML file describes a run (method, objectives, budget, world).
+
+Layout (every key optional except where noted; defaults are the paper's, SPEC section 7)::
+
+    [experiment]
+    name = "S2"                  # label used in file names and the analysis
+    method = "hyperneat-m"       # "hyperneat-m" | "neat-m"
+    objectives = ["task"]        # any of "task", "morphology", "controller"
+    seed = 1                     # run seed: every random choice flows from it
+    generations = 250
+    population = 150
+    trials = 5                   # trials (episodes) per genome, mean ft is the fitness
+    convergence_stop = true      # SO only: stop once the best genome gathers all blocks in
+                                 # half the allowed steps (mean ft >= 100 + bonus / 2)
+    neat_config = "hyperneat_m.neat.cfg"   # neat-python config, relative to this file
+
+    [environment]                # any gathering_env keyword: environment, max_cycles, ...
+    environment = 2
+    max_cycles = 10000
+
+    [substrate]                  # HyperNEAT-M substrate options (evolution.substrate.Substrate)
+    bottom_on_node0 = true
+
+``load_experiment(path, overrides)`` validates everything and raises ``ExperimentError``
+(a ``ValueError``) naming the file and the key.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import asdict, dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any
+
+from gathering_env.config import WorldConfig
+
+METHODS = ("hyperneat-m", "neat-m")
+OBJECTIVES = ("task", "morphology", "controller")
+DEFAULT_NEAT_CONFIGS = {"hyperneat-m": "hyperneat_m.neat.cfg", "neat-m": "neat_m.neat.cfg"}
+CONFIG_DIR = Path(__file__).resolve().parent.parent / "configs"
+
+
+class ExperimentError(ValueError):
+    """A broken or inconsistent experiment file or override."""
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """A validated experiment: what to evolve, for how long, in which world."""
+
+    name: str = "experiment"
+    method: str = "hyperneat-m"
+    objectives: tuple[str, ...] = ("task",)
+    seed: int = 1
+    generations: int = 250
+    population: int = 150
+    trials: int = 5
+    convergence_stop: bool = True
+    neat_config: Path = field(default_factory=lambda: CONFIG_DIR / DEFAULT_NEAT_CONFIGS["hyperneat-m"])
+    environment: dict[str, Any] = field(default_factory=lambda: {"environment": 2, "max_cycles": 10_000})
+    substrate: dict[str, Any] = field(default_factory=dict)
+    source: str = "<defaults>"
+
+    @property
+    def multi_objective(self) -> bool:
+        return len(self.objectives) > 1
+
+    def world_config(self) -> WorldConfig:
+        return WorldConfig.from_kwargs(**self.environment)
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["neat_config"] = str(self.neat_config)
+        d["objectives"] = list(self.objectives)
+        return d
+
+
+_EXPERIMENT_KEYS = {f.name for f in fields(Experiment)} - {"environment", "substrate", "source"}
+
+
+def load_experiment(path: str | Path | None = None, overrides: dict[str, Any] | None = None) -> Experiment:
+    """Read a TOML experiment file (or the defaults if ``path`` is None) and apply overrides.
+
+    Args:
+        path: the TOML file. overrides: flat keys of ``[experiment]`` (e.g. ``generations``)
+            or ``environment.<key>`` / ``substrate.<key>``.
+
+    Raises:
+        ExperimentError: unreadable/invalid TOML, unknown section or key, bad value.
+    """
+    raw: dict[str, Any] = {}
+    base = CONFIG_DIR
+    source = "<defaults>"
+    if path is not None:
+        path = Path(path)
+        source = str(path)
+        try:
+            raw = tomllib.loads(path.read_text(encoding="utf-8"))
+        except FileNotFoundError:
+            raise ExperimentError(f"{path}: experiment file not found") from None
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+            raise ExperimentError(f"{path}: not valid TOML: {err}") from None
+        base = path.resolve().parent
+    unknown_sections = sorted(set(raw) - {"experiment", "environment", "substrate"})
+    if unknown_sections:
+        raise ExperimentError(
+            f"{source}: unknown section(s) {unknown_sections}; allowed: [experiment], [environment], [substrate]"
+        )
+    exp_section = dict(raw.get("experiment", {}))
+    env_section = dict(raw.get("environment", {"environment": 2, "max_cycles": 10_000}))
+    sub_section = dict(raw.get("substrate", {}))
+    for key, value in (overrides or {}).items():
+        if value is None:
+            continue
+        if key.startswith("environment."):
+            env_section[key.split(".", 1)[1]] = value
+        elif key.startswith("substrate."):
+            sub_section[key.split(".", 1)[1]] = value
+        else:
+            exp_section[key] = value
+
+    unknown = sorted(set(exp_section) - _EXPERIMENT_KEYS)
+    if unknown:
+        raise ExperimentError(f"{source}: unknown key(s) {unknown} in [experiment]; allowed: {sorted(_EXPERIMENT_KEYS)}")
+    values: dict[str, Any] = {"source": source}
+    for key, value in exp_section.items():
+        values[key] = _check_key(source, key, value)
+    method = values.get("method", "hyperneat-m")
+    neat_cfg = values.get("neat_config", DEFAULT_NEAT_CONFIGS[method])
+    neat_path = Path(neat_cfg)
+    if not neat_path.is_absolute():
+        candidates = [base / neat_path, CONFIG_DIR / neat_path]
+        neat_path = next((p for p in candidates if p.exists()), candidates[0])
+    if not neat_path.exists():
+        raise ExperimentError(f"{source}: [experiment] neat_config: file {neat_path} not found")
+    values["neat_config"] = neat_path
+    try:
+        WorldConfig.from_kwargs(**env_section)
+    except (ValueError, TypeError) as err:
+        raise ExperimentError(f"{source}: [environment] {err}") from None
+    values["environment"] = env_section
+    values["substrate"] = sub_section
+    return Experiment(**values)
+
+
+def _check_key(source: str, key: str, value: Any) -> Any:
+    where = f"{source}: [experiment] {key}"
+    if key == "name":
+        if not isinstance(value, str) or not value or any(c in value for c in "/\\"):
+            raise ExperimentError(f"{where}={value!r} must be a non-empty name without slashes")
+        return value
+    if key == "method":
+        if value not in METHODS:
+            raise ExperimentError(f"{where}={value!r}; allowed: {list(METHODS)}")
+        return value
+    if key == "objectives":
+        if isinstance(value, str):
+            value = [value]
+        if not isinstance(value, list) or not value or any(v not in OBJECTIVES for v in value):
+            raise ExperimentError(f"{where}={value!r}; allowed: a non-empty list of {list(OBJECTIVES)}")
+        if "task" not in value:
+            raise ExperimentError(f"{where}={value!r} must include 'task'")
+        if len(set(value)) != len(value):
+            raise ExperimentError(f"{where}={value!r} lists an objective twice")
+        return tuple(value)
+    if key in ("seed", "generations", "population", "trials"):
+        low = {"seed": 0, "generations": 1, "population": 2, "trials": 1}[key]
+        if isinstance(value, bool) or not isinstance(value, int) or value < low:
+            raise ExperimentError(f"{where}={value!r} must be an integer >= {low}")
+        return value
+    if key == "convergence_stop":
+        if not isinstance(value, bool):
+            raise ExperimentError(f"{where}={value!r} must be true or false")
+        return value
+    if key == "neat_config":
+        if not isinstance(value, (str, Path)):
+            raise ExperimentError(f"{where}={value!r} must be a file path")
+        return value
+    raise ExperimentError(f"{where}: unknown key")  # pragma: no cover - filtered above
+
+
+def with_overrides(experiment: Experiment, **changes: Any) -> Experiment:
+    """A copy of ``experiment`` with top-level fields replaced (no re-validation of files)."""
+    return replace(experiment, **changes)
