@@ -64,6 +64,7 @@ class SensorBank:
         self.block_needs = np.asarray(block_needs, dtype=float)
 
         present = set(self.types.tolist())
+        self._present = frozenset(present)
         self._cone_idx = np.flatnonzero(self.types != BOTTOM)   # sensors that look into a cone
         self._bottom_idx = np.flatnonzero(self.types == BOTTOM)
         cone_types = self.types[self._cone_idx]
@@ -183,16 +184,20 @@ class SensorBank:
                 need_seen[rows] = np.add.reduceat(np.where(seen, self._obj_need[kk, None], 0.0), starts)
 
         readings = np.zeros((n, rng.size))
+        present = self._present
         if self._needs_walls:
             d_wall = self._wall_distance(mx, my, hx, hy)
             d_any = np.minimum(np.minimum(d_robot, d_block), d_wall)
-            closeness = np.where(d_any < rng, 1.0 - d_any * self._inv_range_c, 0.0)  # (N, C)
-            ir = closeness ** cfg.ir_gamma if cfg.ir_response == "gamma" else closeness
-            readings = np.where(self._is[IR], ir, readings)
-            readings = np.where(self._is[US], np.minimum(closeness / 0.95, 1.0), readings)
-            colour = np.where(d_block <= d_any, 0.5 + 0.5 * closeness,
-                              np.where((d_wall <= d_any) & (d_robot > d_any), 0.5 * closeness, 0.0))
-            readings = np.where(self._is[COLOUR] & (d_any < rng), colour, readings)
+            closeness = np.maximum(1.0 - d_any * self._inv_range_c, 0.0)   # 0 when nothing seen
+            if IR in present:
+                ir = closeness ** cfg.ir_gamma if cfg.ir_response == "gamma" else closeness
+                readings = np.where(self._is[IR], ir, readings)
+            if US in present:
+                readings = np.where(self._is[US], np.minimum(closeness / 0.95, 1.0), readings)
+            if COLOUR in present:
+                colour = np.where(d_block <= d_any, 0.5 + 0.5 * closeness,
+                                  np.where((d_wall <= d_any) & (d_robot > d_any), 0.5 * closeness, 0.0))
+                readings = np.where(self._is[COLOUR] & (d_any < rng), colour, readings)
         if self._needs_camera:
             team = robots_seen + 1.0
             ok = (need_seen > 0) & (team <= need_seen)
