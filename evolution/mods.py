@@ -1,0 +1,204 @@
+"""NEAT-MODS: multi-objective reproduction for neat-python (Abramovich & Moshaiov, 2016).
+
+``MODSReproduction`` is a neat-python reproduction class: pass it as ``reproduction_type``
+to ``neat.Config`` and put its parameters in a ``[MODSReproduction]`` section::
+
+    [MODSReproduction]
+    species_bound_fraction = 0.5   # at most this fraction of N species survive (SPEC: N/2)
+    tournament_size        = 2     # parent choice within a species, by rank score
+    crossover_rate         = 0.5   # else the child is a mutated copy of one parent
+
+neat-python's loop evaluates the population and then calls ``reproduce``. This class keeps
+the previous parents with their objectives, so each call (SPEC section 6):
+
+1. pools the previous N parents with the N offspring just evaluated (2N, elitist: parents
+   are never evaluated twice);
+2. speciates the pool with the run's species set and sorts it by NSGA-II (non-dominated
+   fronts, crowding distance within a front; ties by genome id); each genome gets a rank
+   score, descending from the pool size in sort order;
+3. walks the sorted pool and selects each genome's species the first time it appears, up
+   to ``floor(species_bound_fraction * N)`` species;
+4. serial progression: each selected species' members sorted by rank score, one genome
+   per species per round, round after round, until N parents are chosen. (Only if the
+   selected species hold fewer than N genomes altogether are further species admitted, in
+   sort order, so that exactly N parents are always returned);
+5. gives each selected species offspring in proportion to its parents' summed rank scores
+   (largest remainder), bred by tournament on rank score, crossover and mutation.
+
+Genomes must carry ``genome.objectives``, a tuple of floats, all maximised (the trainer
+sets it; ``genome.fitness`` stays the task objective for neat-python's reporters). After
+``reproduce`` the attributes ``parents`` (the N selected genomes) and ``front`` (first
+front of the pool: list of (genome id, objectives)) describe the generation.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from itertools import count
+from typing import Any
+
+import numpy as np
+from neat.config import ConfigParameter, DefaultClassConfig
+from neat.innovation import InnovationTracker
+
+from .pareto import nsga2_order
+
+
+class MODSReproduction(DefaultClassConfig):
+    """NSGA-II selection over parents + offspring with NEAT speciation (see module docstring)."""
+
+    @classmethod
+    def parse_config(cls, param_dict: dict[str, str]) -> DefaultClassConfig:
+        config = DefaultClassConfig(param_dict, [
+            ConfigParameter("species_bound_fraction", float, 0.5),
+            ConfigParameter("tournament_size", int, 2),
+            ConfigParameter("crossover_rate", float, 0.5),
+        ], "MODSReproduction")
+        if not 0.0 < config.species_bound_fraction <= 1.0:
+            raise ValueError(
+                f"[MODSReproduction] species_bound_fraction={config.species_bound_fraction}; allowed: (0, 1]"
+            )
+        if config.tournament_size < 1:
+            raise ValueError(f"[MODSReproduction] tournament_size={config.tournament_size}; allowed: >= 1")
+        if not 0.0 <= config.crossover_rate <= 1.0:
+            raise ValueError(f"[MODSReproduction] crossover_rate={config.crossover_rate}; allowed: [0, 1]")
+        return config
+
+    def __init__(self, config: DefaultClassConfig, reporters: Any, stagnation: Any) -> None:
+        # pylint: disable=super-init-not-called
+        self.reproduction_config = config
+        self.reporters = reporters
+        self.stagnation = stagnation  # unused: MODS has no stagnation, species die by selection
+        self.genome_indexer = count(1)
+        self.ancestors: dict[int, tuple[int, ...]] = {}
+        self.innovation_tracker = InnovationTracker()
+        self.parents: dict[int, Any] = {}
+        self.front: list[tuple[int, tuple[float, ...]]] = []
+
+    def create_new(self, genome_type: type, genome_config: Any, num_genomes: int) -> dict[int, Any]:
+        genome_config.innovation_tracker = self.innovation_tracker
+        genomes = {}
+        for _ in range(num_genomes):
+            key = next(self.genome_indexer)
+            g = genome_type(key)
+            g.configure_new(genome_config)
+            genomes[key] = g
+            self.ancestors[key] = ()
+        return genomes
+
+    # ------------------------------------------------------------------ selection
+    def select(self, pool: dict[int, Any], species_of: dict[int, int], n: int
+               ) -> tuple[list[int], dict[int, float], list[int]]:
+        """NSGA-II sort, species selection and serial progression over ``pool``.
+
+        Args:
+            pool: genome id -> genome with ``objectives``. species_of: genome id -> species id.
+            n: number of parents to select.
+
+        Returns:
+            (parent ids in selection order, rank score of every pool genome, selected species).
+        """
+        keys = sorted(pool)
+        objectives = np.array([_objectives(pool[k]) for k in keys], dtype=float)
+        order, front_of, _ = nsga2_order(objectives)
+        ranked = [keys[i] for i in order]
+        score = {k: float(len(keys) - pos) for pos, k in enumerate(ranked)}
+        self.front = [(keys[i], tuple(objectives[i])) for i in order if front_of[i] == 0]
+
+        bound = max(1, math.floor(self.reproduction_config.species_bound_fraction * n))
+        selected: list[int] = []
+        for k in ranked:
+            sid = species_of[k]
+            if sid not in selected:
+                selected.append(sid)
+                if len(selected) == bound:
+                    break
+        members = {sid: [k for k in ranked if species_of[k] == sid] for sid in selected}
+        if sum(len(m) for m in members.values()) < n:
+            for k in ranked:  # too few genomes in the bounded species: admit more, in order
+                sid = species_of[k]
+                if sid not in members:
+                    selected.append(sid)
+                    members[sid] = [g for g in ranked if species_of[g] == sid]
+                    if sum(len(m) for m in members.values()) >= n:
+                        break
+        parents: list[int] = []
+        depth = 0
+        while len(parents) < min(n, len(pool)):
+            for sid in selected:
+                if depth < len(members[sid]) and len(parents) < n:
+                    parents.append(members[sid][depth])
+            depth += 1
+        return parents, score, selected
+
+    @staticmethod
+    def offspring_counts(species_scores: dict[int, float], n: int) -> dict[int, int]:
+        """Split ``n`` offspring over species in proportion to their summed rank scores."""
+        total = sum(species_scores.values())
+        sids = list(species_scores)
+        exact = {sid: n * species_scores[sid] / total for sid in sids}
+        counts = {sid: int(math.floor(exact[sid])) for sid in sids}
+        leftover = n - sum(counts.values())
+        by_remainder = sorted(sids, key=lambda s: (-(exact[s] - counts[s]), sids.index(s)))
+        for sid in by_remainder[:leftover]:
+            counts[sid] += 1
+        return counts
+
+    # ------------------------------------------------------------------ reproduction
+    def reproduce(self, config: Any, species: Any, pop_size: int, generation: int) -> dict[int, Any]:
+        """Select N parents from parents + evaluated offspring and breed N new offspring."""
+        config.genome_config.innovation_tracker = self.innovation_tracker
+        self.innovation_tracker.reset_generation()
+        offspring = {gid: g for s in species.species.values() for gid, g in s.members.items()}
+        pool = {**self.parents, **offspring}
+        for gid, g in pool.items():
+            if getattr(g, "objectives", None) is None:
+                raise RuntimeError(f"genome {gid} has no 'objectives': the fitness function must set them")
+        species.speciate(config, pool, generation)
+        species_of = dict(species.genome_to_species)
+        parent_ids, score, selected = self.select(pool, species_of, pop_size)
+        self.parents = {k: pool[k] for k in parent_ids}
+
+        by_species: dict[int, list[int]] = {sid: [] for sid in selected}
+        for k in parent_ids:
+            by_species[species_of[k]].append(k)
+        by_species = {sid: ks for sid, ks in by_species.items() if ks}
+        counts = self.offspring_counts({sid: sum(score[k] for k in ks) for sid, ks in by_species.items()},
+                                       pop_size)
+        # Keep only the surviving species (with their parents as members) in the species set.
+        for sid in list(species.species):
+            if sid not in by_species:
+                del species.species[sid]
+            else:
+                species.species[sid].members = {k: pool[k] for k in by_species[sid]}
+
+        new_population: dict[int, Any] = {}
+        cfg = self.reproduction_config
+        for sid, ks in by_species.items():
+            for _ in range(counts[sid]):
+                p1 = self._tournament(ks, score, cfg.tournament_size)
+                gid = next(self.genome_indexer)
+                child = config.genome_type(gid)
+                if random.random() < cfg.crossover_rate:
+                    p2 = self._tournament(ks, score, cfg.tournament_size)
+                    child.configure_crossover(pool[p1], pool[p2], config.genome_config)
+                    self.ancestors[gid] = (p1, p2)
+                else:
+                    child.configure_crossover(pool[p1], pool[p1], config.genome_config)
+                    self.ancestors[gid] = (p1,)
+                child.mutate(config.genome_config)
+                new_population[gid] = child
+        return new_population
+
+    @staticmethod
+    def _tournament(candidates: list[int], score: dict[int, float], size: int) -> int:
+        picks = [random.choice(candidates) for _ in range(size)]
+        return max(picks, key=lambda k: (score[k], -k))
+
+
+def _objectives(genome: Any) -> tuple[float, ...]:
+    values = tuple(float(v) for v in genome.objectives)
+    if any(math.isnan(v) for v in values):
+        raise RuntimeError(f"genome {genome.key} has NaN objectives {values}")
+    return values
