@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from gathering_env import Morphology, SENSOR_TYPES, morphological_complexity, parallel_env
+from gathering_env import SENSOR_TYPES, Morphology, morphological_complexity, parallel_env
 
 _ENV_CACHE: dict[str, Any] = {}
 

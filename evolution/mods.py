@@ -75,6 +75,7 @@ class MODSReproduction(DefaultClassConfig):
         self.innovation_tracker = InnovationTracker()
         self.parents: dict[int, Any] = {}
         self.front: list[tuple[int, tuple[float, ...]]] = []
+        self.front_genomes: dict[int, Any] = {}
 
     def create_new(self, genome_type: type, genome_config: Any, num_genomes: int) -> dict[int, Any]:
         genome_config.innovation_tracker = self.innovation_tracker
@@ -159,6 +160,7 @@ class MODSReproduction(DefaultClassConfig):
         species_of = dict(species.genome_to_species)
         parent_ids, score, selected = self.select(pool, species_of, pop_size)
         self.parents = {k: pool[k] for k in parent_ids}
+        self.front_genomes = {k: pool[k] for k, _ in self.front}
 
         by_species: dict[int, list[int]] = {sid: [] for sid in selected}
         for k in parent_ids:

@@ -31,6 +31,8 @@ from typing import Any
 
 import neat
 
+from gathering_env import morphological_complexity as morphology_simplicity
+
 from .backends import EvalContext, make_evaluator
 from .champion import save_champion
 from .checkpoint import CheckpointError, load_checkpoint, save_checkpoint
@@ -54,10 +56,20 @@ def genome_class(method: str) -> type:
 
 
 def make_neat_config(experiment: Experiment) -> neat.Config:
-    """Load the experiment's neat-python config; the population size comes from the experiment."""
+    """Load the experiment's neat-python config; the population size comes from the experiment.
+
+    Single-objective runs use neat-python's ``DefaultReproduction``; multi-objective runs
+    use ``MODSReproduction`` (its ``[MODSReproduction]`` section in the same file).
+    """
     path = experiment.neat_config
+    if experiment.multi_objective:
+        from .mods import MODSReproduction
+
+        reproduction: type = MODSReproduction
+    else:
+        reproduction = neat.DefaultReproduction
     try:
-        config = neat.Config(genome_class(experiment.method), neat.DefaultReproduction,
+        config = neat.Config(genome_class(experiment.method), reproduction,
                              neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
     except Exception as err:  # neat raises several error types for broken files
         raise ExperimentError(f"{path}: invalid neat-python config: {err}") from None
@@ -185,7 +197,7 @@ class Trainer:
         exp = self.experiment
         population = self._prepare()
         context = EvalContext(self.config, dict(exp.environment), exp.trials, exp.seed, exp.method, self.substrate)
-        evaluator = make_evaluator(context, self.workers)
+        evaluator = self._evaluator = make_evaluator(context, self.workers)
         bar = None
         if self.progress:
             from tqdm import tqdm
@@ -199,17 +211,13 @@ class Trainer:
                 start = time.perf_counter()
                 species_count = len(population.species.species)
 
-                def fitness(genomes: list[tuple[int, Any]], config: neat.Config) -> None:
-                    evaluations = evaluator.map([g for _, g in genomes], generation)
-                    self._current = {}
-                    for (key, g), ev in zip(genomes, evaluations):
-                        g.fitness = ev.task
-                        g.objectives = ev.objectives(exp.objectives)
-                        self._current[key] = ev
-                    self._current_genomes = dict(genomes)
-
-                population.run(fitness, 1)
+                self._generation = generation
+                population.run(self._fitness, 1)
                 record = self._record(generation, species_count, time.perf_counter() - start)
+                if exp.multi_objective:
+                    front = population.reproduction.front
+                    record["front"] = {"genomes": [k for k, _ in front], "objectives": [list(o) for _, o in front],
+                                       "names": list(exp.objectives)}
                 append_stats(self.stats_path, record)
                 self._save_checkpoint(population)
                 if bar is not None:
@@ -222,10 +230,22 @@ class Trainer:
             evaluator.close()
             if bar is not None:
                 bar.close()
+        if exp.multi_objective:
+            self._write_front(population)
         self._plot()
         records = read_stats(self.stats_path)
         return RunResult(self.run_dir, len(records), max((r["task_best"] for r in records), default=0.0),
                          self.champion_path if self.champion_path.exists() else None, converged)
+
+    def _fitness(self, genomes: list[tuple[int, Any]], config: neat.Config) -> None:
+        """neat-python fitness function: evaluate on the backend, set fitness and objectives."""
+        evaluations = self._evaluator.map([g for _, g in genomes], self._generation)
+        self._current = {}
+        for (key, g), ev in zip(genomes, evaluations):
+            g.fitness = ev.task
+            g.objectives = ev.objectives(self.experiment.objectives)
+            self._current[key] = ev
+        self._current_genomes = dict(genomes)
 
     def _record(self, generation: int, species_count: int, seconds: float) -> dict[str, Any]:
         evaluations = list(self._current.values())
@@ -245,6 +265,25 @@ class Trainer:
                       objectives={"task": evaluation.task, "morphology": evaluation.morphology,
                                   "controller": evaluation.controller},
                       environment=exp.environment)
+
+    def _write_front(self, population: neat.Population) -> None:
+        """Write every genome of the final first front as a JSON champion in ``front/``."""
+        exp = self.experiment
+        reproduction = population.reproduction
+        front_dir = self.run_dir / "front"
+        front_dir.mkdir(exist_ok=True)
+        for old in front_dir.glob("genome-*.json"):
+            old.unlink()
+        generation = population.generation - 1
+        for key, objectives in reproduction.front:
+            genome = reproduction.parents.get(key) or reproduction.front_genomes[key]
+            controller, morphology = decode_genome(exp.method, genome, self.config, self.substrate)
+            values = dict(zip(exp.objectives, objectives))
+            values.setdefault("morphology", morphology_simplicity(morphology))
+            values.setdefault("controller", 100.0 - float(controller.num_links))
+            save_champion(front_dir / f"genome-{key}.json", method=exp.method, experiment=exp.name,
+                          generation=generation, genome=genome, morphology=morphology,
+                          controller=controller, objectives=values, environment=exp.environment)
 
     def _plot(self) -> None:
         from .plots import plot_run

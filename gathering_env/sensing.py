@@ -212,7 +212,6 @@ class SensorBank:
         ``delta`` with the sensor axis, the nearest wall point inside a cone of half-angle
         ``a`` lies at ``perp / cos(max(delta - a, 0))`` (visible while that angle < 90 deg).
         """
-        cfg = self.config
         heading = np.stack((hx, hy), axis=-1)                            # (N, C, 2)
         cos_d = heading @ _WALL_NORMALS.T                                 # (N, C, 4)
         sin_d = np.abs(heading @ _WALL_TANGENTS.T)
