@@ -1,4 +1,4 @@
-"""Command-line entry points: ``gathering-evolve`` and ``gathering-replay``.
+"""Command-line entry points: ``gathering-evolve``, ``gathering-replay``, ``gathering-analyze``.
 
 Errors in input files (experiment TOML, neat config, checkpoint, champion) end with a
 one-line message naming the file and field and exit status 2; nothing already written is
@@ -110,9 +110,35 @@ def replay_main(argv: list[str] | None = None) -> int:
     return 0
 
 
+def analyze_main(argv: list[str] | None = None) -> int:
+    """``gathering-analyze RUN_DIR... --out report/``."""
+    parser = argparse.ArgumentParser(
+        prog="gathering-analyze",
+        description="Merge MO fronts, compute selection points and SO-vs-MO tests; write Table 4, "
+                    "Figures 4-6 and report.md.",
+    )
+    parser.add_argument("runs", nargs="+", type=Path, help="run directories written by gathering-evolve")
+    parser.add_argument("--out", type=Path, default=Path("report"), help="output directory (default: report/)")
+    args = parser.parse_args(argv)
+    from .analysis import analyse
+    from .report import write_report
+
+    try:
+        analysis = analyse(args.runs)
+    except ValueError as err:
+        return _fail(str(err))
+    path = write_report(analysis, args.out)
+    print(f"{len(analysis.runs)} runs, {len(analysis.comparisons)} comparisons -> {path}")
+    return 0
+
+
 def run_evolve() -> None:
     sys.exit(evolve_main())
 
 
 def run_replay() -> None:
     sys.exit(replay_main())
+
+
+def run_analyze() -> None:
+    sys.exit(analyze_main())

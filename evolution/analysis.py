@@ -1,0 +1,187 @@
+"""From run directories to the paper's comparison: fronts, selection points, tests, table.
+
+Runs are grouped by (kind, environment): *SO* runs optimise the task alone, *MO* runs
+also the morphology (or more objectives). For every group:
+
+* SO: each run contributes its champion (best task performance) as a point
+  (ft, C = morphological simplicity); "AVG SO" is their mean.
+* MO: each run contributes its final first front (``front/*.json``); the fronts of all
+  repetitions are merged by non-dominated sorting on (ft, C) (Figure 4).
+* Selection points, per MO run front (paper section 5.1): **max** (best ft), **mean** (the
+  front's mean on both objectives), **knee** (smallest Euclidean distance to the utopia
+  point (1, 1) after normalising each objective to [0, 1] over the front) and **epsilon**
+  (the simplest point whose ft is within 10 % of the front's max ft).
+* Statistics: Shapiro-Wilk on every sample, then Student's two-sample t-test (scipy)
+  comparing the SO champions with each selection point, for ft and for C (Table 4).
+"""
+
+from __future__ import annotations
+
+import json
+from collections import defaultdict
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy import stats as sps
+
+from .pareto import non_dominated_fronts
+from .stats import read_stats
+
+SELECTION_POINTS = ("max", "mean", "knee", "epsilon")
+EPSILON = 0.10
+
+
+@dataclass
+class Run:
+    """What the analysis needs from one run directory."""
+
+    path: Path
+    name: str
+    environment: int
+    multi_objective: bool
+    records: list[dict[str, Any]]
+    champion: tuple[float, float] | None        # (ft, C) of the best-ft genome
+    front: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (F, 2) rows (ft, C)
+
+
+def load_run(path: Path) -> Run:
+    """Read ``experiment.json``, ``stats.jsonl``, ``champion.json`` and ``front/*.json``."""
+    path = Path(path)
+    try:
+        experiment = json.loads((path / "experiment.json").read_text())
+    except FileNotFoundError:
+        raise ValueError(f"{path}: not a run directory (experiment.json missing)") from None
+    except json.JSONDecodeError as err:
+        raise ValueError(f"{path / 'experiment.json'}: not valid JSON: {err}") from None
+    env = int(experiment.get("environment", {}).get("environment") or 0)
+    multi = len(experiment.get("objectives", ["task"])) > 1
+    records = read_stats(path / "stats.jsonl")
+    if not records:
+        raise ValueError(f"{path}: no statistics (stats.jsonl empty or missing)")
+    champion = None
+    champ_file = path / "champion.json"
+    if champ_file.exists():
+        obj = json.loads(champ_file.read_text())["objectives"]
+        champion = (float(obj["task"]), float(obj["morphology"]))
+    points = []
+    for f in sorted((path / "front").glob("*.json")):
+        obj = json.loads(f.read_text())["objectives"]
+        points.append((float(obj["task"]), float(obj["morphology"])))
+    front = np.array(points, dtype=float).reshape(-1, 2)
+    if len(front):
+        front = front[non_dominated_fronts(front)[0]]
+    return Run(path, experiment.get("name", path.name), env, multi, records, champion, front)
+
+
+def merge_fronts(fronts: list[np.ndarray]) -> np.ndarray:
+    """Non-dominated union of several (F, 2) fronts, sorted by ft descending."""
+    stacked = np.concatenate([f for f in fronts if len(f)] or [np.zeros((0, 2))])
+    if not len(stacked):
+        return stacked
+    merged = np.unique(stacked[non_dominated_fronts(stacked)[0]], axis=0)
+    return merged[np.argsort(-merged[:, 0], kind="stable")]
+
+
+def selection_points(front: np.ndarray, epsilon: float = EPSILON) -> dict[str, tuple[float, float]]:
+    """The four selection points (ft, C) of one front (rows (ft, C), both maximised)."""
+    if not len(front):
+        raise ValueError("empty front")
+    ft, c = front[:, 0], front[:, 1]
+    best = int(np.lexsort((-c, -ft))[0])  # max ft, ties -> simpler
+    span = np.ptp(front, axis=0)
+    norm = (front - front.min(axis=0)) / np.where(span > 0, span, 1.0)
+    norm[:, span == 0] = 1.0  # a flat objective is at its best everywhere
+    knee = int(np.lexsort((-ft, np.hypot(1.0 - norm[:, 0], 1.0 - norm[:, 1])))[0])
+    ok = ft >= ft[best] - epsilon * abs(ft[best])
+    candidates = np.flatnonzero(ok)
+    eps = int(candidates[np.lexsort((-ft[candidates], -c[candidates]))[0]])
+    return {
+        "max": (float(ft[best]), float(c[best])),
+        "mean": (float(ft.mean()), float(c.mean())),
+        "knee": (float(ft[knee]), float(c[knee])),
+        "epsilon": (float(ft[eps]), float(c[eps])),
+    }
+
+
+@dataclass
+class Comparison:
+    """SO champions vs one selection point of the MO fronts, for one objective."""
+
+    environment: int
+    point: str
+    objective: str               # "task" or "morphology"
+    so_mean: float
+    mo_mean: float
+    difference_percent: float    # (MO - SO) / |SO| * 100
+    superior: str                # "SO", "MO" or "=" (no significant difference)
+    t_statistic: float
+    p_value: float
+    shapiro_so_p: float
+    shapiro_mo_p: float
+    n_so: int
+    n_mo: int
+
+
+def _shapiro(sample: np.ndarray) -> float:
+    if len(sample) < 3 or np.ptp(sample) == 0:
+        return float("nan")
+    return float(sps.shapiro(sample).pvalue)
+
+
+def compare(so: np.ndarray, mo: np.ndarray, environment: int, point: str, objective: str,
+            alpha: float = 0.05) -> Comparison:
+    """Student's t-test (equal variances) of two samples, with Shapiro-Wilk p-values."""
+    so, mo = np.asarray(so, float), np.asarray(mo, float)
+    if len(so) >= 2 and len(mo) >= 2 and (np.ptp(so) > 0 or np.ptp(mo) > 0):
+        result = sps.ttest_ind(mo, so, equal_var=True)
+        t, p = float(result.statistic), float(result.pvalue)
+    else:
+        t, p = float("nan"), float("nan")
+    so_mean, mo_mean = float(so.mean()), float(mo.mean())
+    diff = (mo_mean - so_mean) / abs(so_mean) * 100.0 if so_mean else float("nan")
+    superior = "=" if not (p < alpha) else ("MO" if mo_mean > so_mean else "SO")
+    return Comparison(environment, point, objective, so_mean, mo_mean, diff, superior, t, p,
+                      _shapiro(so), _shapiro(mo), len(so), len(mo))
+
+
+@dataclass
+class Analysis:
+    runs: list[Run]
+    merged_fronts: dict[int, np.ndarray]
+    so_points: dict[int, np.ndarray]                         # env -> (R, 2) champions
+    run_points: dict[int, dict[str, np.ndarray]]             # env -> point -> (R, 2)
+    merged_points: dict[int, dict[str, tuple[float, float]]]  # points of the merged front
+    comparisons: list[Comparison]
+
+
+def analyse(run_dirs: list[Path]) -> Analysis:
+    """Load and compare all runs (see the module docstring)."""
+    runs = [load_run(p) for p in run_dirs]
+    so_by_env: dict[int, list[tuple[float, float]]] = defaultdict(list)
+    mo_by_env: dict[int, list[np.ndarray]] = defaultdict(list)
+    for run in runs:
+        if run.multi_objective:
+            if len(run.front):
+                mo_by_env[run.environment].append(run.front)
+        elif run.champion is not None:
+            so_by_env[run.environment].append(run.champion)
+    merged = {e: merge_fronts(f) for e, f in mo_by_env.items()}
+    run_points = {
+        e: {p: np.array([selection_points(f)[p] for f in fronts]) for p in SELECTION_POINTS}
+        for e, fronts in mo_by_env.items()
+    }
+    merged_points = {e: selection_points(f) for e, f in merged.items() if len(f)}
+    so_points = {e: np.array(v) for e, v in so_by_env.items()}
+    comparisons = []
+    for env in sorted(set(so_points) & set(run_points)):
+        for point in SELECTION_POINTS:
+            for j, objective in enumerate(("task", "morphology")):
+                comparisons.append(compare(so_points[env][:, j], run_points[env][point][:, j], env, point, objective))
+    return Analysis(runs, merged, so_points, run_points, merged_points, comparisons)
+
+
+def table4_rows(analysis: Analysis) -> list[dict[str, Any]]:
+    """Flat rows of Table 4 (one per environment x point x objective)."""
+    return [c.__dict__.copy() for c in analysis.comparisons]

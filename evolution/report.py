@@ -1,0 +1,147 @@
+"""Write the analysis as files: Table 4 (markdown + CSV), Figures 4-6 (PNG), report.md."""
+
+from __future__ import annotations
+
+import csv
+from collections import defaultdict
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .analysis import SELECTION_POINTS, Analysis  # noqa: E402
+
+ENV_COLOURS = {1: "tab:blue", 2: "tab:orange", 3: "tab:red"}
+POINT_MARKERS = {"max": "^", "mean": "s", "knee": "D", "epsilon": "P"}
+
+
+def write_table4(analysis: Analysis, out: Path) -> tuple[Path, Path]:
+    rows = [c.__dict__ for c in analysis.comparisons]
+    csv_path = out / "table4.csv"
+    with open(csv_path, "w", newline="") as f:
+        if rows:
+            writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+            writer.writeheader()
+            writer.writerows(rows)
+    envs = sorted({c.environment for c in analysis.comparisons})
+    lines = ["| SO vs | " + " | ".join(f"env {e} ft | env {e} C" for e in envs) + " |",
+             "|---|" + "---|---|" * len(envs)]
+    cell = {(c.environment, c.point, c.objective): c for c in analysis.comparisons}
+    for point in SELECTION_POINTS:
+        parts = []
+        for e in envs:
+            for obj in ("task", "morphology"):
+                c = cell.get((e, point, obj))
+                if c is None:
+                    parts.append("")
+                elif c.superior == "=":
+                    parts.append(f"= ({c.difference_percent:+.1f} %, p={c.p_value:.2g})")
+                else:
+                    parts.append(f"{c.superior} {abs(c.difference_percent):.1f} % (p={c.p_value:.2g})")
+        lines.append(f"| {point} | " + " | ".join(parts) + " |")
+    md_path = out / "table4.md"
+    md_path.write_text("\n".join(lines) + "\n")
+    return md_path, csv_path
+
+
+def figure4(analysis: Analysis, out: Path) -> Path:
+    """Merged MO fronts (ft vs C) per environment with the AVG SO point and selection points."""
+    fig, ax = plt.subplots(figsize=(6.5, 4.8), constrained_layout=True)
+    for env, front in sorted(analysis.merged_fronts.items()):
+        colour = ENV_COLOURS.get(env, "k")
+        if len(front):
+            order = np.argsort(front[:, 1])
+            ax.plot(front[order, 1], front[order, 0], "o-", color=colour, ms=4, label=f"MO front, env {env}")
+        for point, (ft, c) in analysis.merged_points.get(env, {}).items():
+            ax.scatter([c], [ft], marker=POINT_MARKERS[point], s=60, facecolors="none", edgecolors=colour)
+    for env, pts in sorted(analysis.so_points.items()):
+        colour = ENV_COLOURS.get(env, "k")
+        ax.scatter(pts[:, 1], pts[:, 0], marker="x", color=colour, alpha=0.5)
+        ax.scatter([pts[:, 1].mean()], [pts[:, 0].mean()], marker="*", s=160, color=colour,
+                   edgecolors="k", label=f"AVG SO, env {env}")
+    for point, marker in POINT_MARKERS.items():
+        ax.scatter([], [], marker=marker, facecolors="none", edgecolors="k", label=point)
+    ax.set_xlabel("morphological simplicity C (eq. 2)")
+    ax.set_ylabel("task performance ft (eq. 1)")
+    ax.set_title("Figure 4: MO fronts vs SO champions")
+    ax.legend(fontsize=7, loc="best")
+    path = out / "figure4_fronts.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def figure5(analysis: Analysis, out: Path) -> Path:
+    """Mean morphological simplicity over generations, MO vs SO, per environment."""
+    curves: dict[tuple[int, bool], list[np.ndarray]] = defaultdict(list)
+    for run in analysis.runs:
+        curves[(run.environment, run.multi_objective)].append(np.array([r["morphology_mean"] for r in run.records]))
+    fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
+    for (env, multi), series in sorted(curves.items()):
+        length = min(len(s) for s in series)
+        mean = np.mean([s[:length] for s in series], axis=0)
+        ax.plot(np.arange(length), mean, color=ENV_COLOURS.get(env, "k"), ls="-" if multi else "--",
+                alpha=1.0 if multi else 0.6, label=f"{'MO' if multi else 'SO'} env {env} (n={len(series)})")
+    ax.set_xlabel("generation")
+    ax.set_ylabel("mean morphological simplicity C")
+    ax.set_title("Figure 5: simplicity over generations")
+    ax.legend(fontsize=7)
+    path = out / "figure5_simplicity.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def figure6(analysis: Analysis, out: Path) -> Path:
+    """Mean simplicity (+- standard error over runs) of each selection point per environment."""
+    envs = sorted(analysis.run_points)
+    fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
+    width = 0.8 / max(len(envs), 1)
+    x = np.arange(len(SELECTION_POINTS))
+    for i, env in enumerate(envs):
+        means, errs = [], []
+        for point in SELECTION_POINTS:
+            c = analysis.run_points[env][point][:, 1]
+            means.append(c.mean())
+            errs.append(c.std(ddof=1) / np.sqrt(len(c)) if len(c) > 1 else 0.0)
+        ax.bar(x + i * width, means, width, yerr=errs, capsize=3, color=ENV_COLOURS.get(env, "k"), label=f"env {env}")
+    ax.set_xticks(x + width * (len(envs) - 1) / 2, SELECTION_POINTS)
+    ax.set_ylabel("morphological simplicity C")
+    ax.set_title("Figure 6: simplicity per selection point")
+    ax.legend(fontsize=7)
+    path = out / "figure6_points.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def write_report(analysis: Analysis, out: Path) -> Path:
+    """All tables and figures plus ``report.md`` tying them together."""
+    out.mkdir(parents=True, exist_ok=True)
+    table_md, table_csv = write_table4(analysis, out)
+    figs = [figure4(analysis, out), figure5(analysis, out), figure6(analysis, out)]
+    lines = ["# Cost on morphological complexity: analysis report", "",
+             f"Runs analysed: {len(analysis.runs)}", ""]
+    lines.append("| run | kind | env | generations | champion ft | champion C | front size |")
+    lines.append("|---|---|---|---|---|---|---|")
+    for r in analysis.runs:
+        ft, c = r.champion if r.champion else (float("nan"), float("nan"))
+        lines.append(f"| {r.path.name} | {'MO' if r.multi_objective else 'SO'} | {r.environment} | "
+                     f"{len(r.records)} | {ft:.2f} | {c:.1f} | {len(r.front) if r.multi_objective else ''} |")
+    lines += ["", "## Selection points of the merged MO fronts (ft, C)", ""]
+    for env, pts in sorted(analysis.merged_points.items()):
+        cells = ", ".join(f"{p} = ({v[0]:.2f}, {v[1]:.1f})" for p, v in pts.items())
+        lines.append(f"* environment {env}: {cells}")
+    for env, pts in sorted(analysis.so_points.items()):
+        lines.append(f"* environment {env}, AVG SO = ({pts[:, 0].mean():.2f}, {pts[:, 1].mean():.1f}) over {len(pts)} runs")
+    lines += ["", "## Table 4: SO vs each selection point", "",
+              "Cells: the superior experiment and the mean difference in % of SO (Student's t-test, "
+              "p < 0.05), or '=' with the difference and p when not significant. Shapiro-Wilk p-values "
+              f"are in `{table_csv.name}`.", "", table_md.read_text(), "## Figures", ""]
+    lines += [f"![{f.stem}]({f.name})" for f in figs]
+    path = out / "report.md"
+    path.write_text("\n".join(lines) + "\n")
+    return path
