@@ -7,6 +7,7 @@ to ``neat.Config`` and put its parameters in a ``[MODSReproduction]`` section::
     species_bound_fraction = 0.5   # at most this fraction of N species survive (SPEC: N/2)
     tournament_size        = 2     # parent choice within a species, by rank score
     crossover_rate         = 0.5   # else the child is a mutated copy of one parent
+    progression            = by_front  # or round_robin (the original's plain serial progression)
 
 neat-python's loop evaluates the population and then calls ``reproduce``. This class keeps
 the previous parents with their objectives, so each call (SPEC section 6):
@@ -19,9 +20,13 @@ the previous parents with their objectives, so each call (SPEC section 6):
 3. walks the sorted pool and selects each genome's species the first time it appears, up
    to ``floor(species_bound_fraction * N)`` species;
 4. serial progression: each selected species' members sorted by rank score, one genome
-   per species per round, round after round, until N parents are chosen. (Only if the
-   selected species hold fewer than N genomes altogether are further species admitted, in
-   sort order, so that exactly N parents are always returned);
+   per species per round, round after round, until N parents are chosen. With the default
+   ``progression = by_front`` the rounds run front by front (every member of a better front
+   of the selected species is taken before any member of a worse one), which keeps
+   NSGA-II's elitism: no first-front genome of a selected species is lost while the front
+   is smaller than N. ``round_robin`` is the original's plain scan over whole species.
+   (Only if the selected species hold fewer than N genomes altogether are further species
+   admitted, in sort order, so that exactly N parents are always returned);
 5. gives each selected species offspring in proportion to its parents' summed rank scores
    (largest remainder), bred by tournament on rank score, crossover and mutation.
 
@@ -54,7 +59,12 @@ class MODSReproduction(DefaultClassConfig):
             ConfigParameter("species_bound_fraction", float, 0.5),
             ConfigParameter("tournament_size", int, 2),
             ConfigParameter("crossover_rate", float, 0.5),
+            ConfigParameter("progression", str, "by_front"),
         ], "MODSReproduction")
+        if config.progression not in ("by_front", "round_robin"):
+            raise ValueError(
+                f"[MODSReproduction] progression={config.progression!r}; allowed: 'by_front', 'round_robin'"
+            )
         if not 0.0 < config.species_bound_fraction <= 1.0:
             raise ValueError(
                 f"[MODSReproduction] species_bound_fraction={config.species_bound_fraction}; allowed: (0, 1]"
@@ -104,6 +114,7 @@ class MODSReproduction(DefaultClassConfig):
         objectives = np.array([_objectives(pool[k]) for k in keys], dtype=float)
         order, front_of, _ = nsga2_order(objectives)
         ranked = [keys[i] for i in order]
+        index = {k: i for i, k in enumerate(keys)}
         score = {k: float(len(keys) - pos) for pos, k in enumerate(ranked)}
         self.front = [(keys[i], tuple(objectives[i])) for i in order if front_of[i] == 0]
 
@@ -125,12 +136,23 @@ class MODSReproduction(DefaultClassConfig):
                     if sum(len(m) for m in members.values()) >= n:
                         break
         parents: list[int] = []
-        depth = 0
-        while len(parents) < min(n, len(pool)):
-            for sid in selected:
-                if depth < len(members[sid]) and len(parents) < n:
-                    parents.append(members[sid][depth])
-            depth += 1
+        if self.reproduction_config.progression == "by_front":
+            # Serial progression front by front: all of a better front before any of a worse
+            # one (NSGA-II elitism), species taking turns within each front.
+            levels = sorted({int(front_of[index[k]]) for sid in selected for k in members[sid]})
+            queues = [[[k for k in members[sid] if front_of[index[k]] == level] for sid in selected]
+                      for level in levels]
+        else:
+            queues = [[members[sid] for sid in selected]]  # the original's plain round robin
+        for rows in queues:
+            depth = 0
+            while len(parents) < n and any(depth < len(r) for r in rows):
+                for row in rows:
+                    if depth < len(row) and len(parents) < n:
+                        parents.append(row[depth])
+                depth += 1
+            if len(parents) >= n:
+                break
         return parents, score, selected
 
     @staticmethod
