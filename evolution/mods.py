@@ -86,6 +86,7 @@ class MODSReproduction(DefaultClassConfig):
         self.parents: dict[int, Any] = {}
         self.front: list[tuple[int, tuple[float, ...]]] = []
         self.front_genomes: dict[int, Any] = {}
+        self.species_of: dict[int, int] = {}
 
     def create_new(self, genome_type: type, genome_config: Any, num_genomes: int) -> dict[int, Any]:
         genome_config.innovation_tracker = self.innovation_tracker
@@ -180,6 +181,7 @@ class MODSReproduction(DefaultClassConfig):
                 raise RuntimeError(f"genome {gid} has no 'objectives': the fitness function must set them")
         species.speciate(config, pool, generation)
         species_of = dict(species.genome_to_species)
+        self.species_of = species_of
         parent_ids, score, selected = self.select(pool, species_of, pop_size)
         self.parents = {k: pool[k] for k in parent_ids}
         self.front_genomes = {k: pool[k] for k, _ in self.front}

@@ -174,7 +174,7 @@ def test_runs_inside_neat_population(tmp_path):
         assert len(repro.parents) == 20                  # N parents kept with their objectives
         assert all(g.objectives is not None for g in repro.parents.values())
         front_keys = {k for k, _ in repro.front}
-        front_species = {population.species.genome_to_species[k] for k in front_keys}
+        front_species = {repro.species_of[k] for k in front_keys}
         if len(front_keys) < 20 and len(front_species) <= 10:  # bound = 0.5 * N
             assert front_keys <= set(repro.parents)      # no first-front genome lost
         # Offspring are new genomes: nothing is evaluated twice.
