@@ -12,9 +12,9 @@ import argparse
 from pathlib import Path
 
 import numpy as np
+from gathering_env.render import save_video
 
 from gathering_env import parallel_env
-from gathering_env.render import save_video
 
 
 def main() -> None:
@@ -24,6 +24,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--frame-every", type=int, default=5, help="record every k-th step")
     parser.add_argument("--out", type=Path, default=Path("out/random_episode.gif"), help=".gif or .mp4")
+    parser.add_argument("--png", type=Path, help="also save the last frame as a PNG picture")
     args = parser.parse_args()
 
     env = parallel_env(environment=args.environment, max_cycles=args.steps, render_mode="rgb_array")
@@ -41,6 +42,11 @@ def main() -> None:
     env.close()
     info = infos["robot_0"]
     path = save_video(frames, args.out, fps=15)
+    if args.png:
+        import imageio.v2 as imageio
+
+        args.png.parent.mkdir(parents=True, exist_ok=True)
+        imageio.imwrite(args.png, frames[-1])
     print(f"environment {args.environment}, {t} steps, random actions")
     print(f"gathered value {info['gathered_value']:.0f} / {info['total_value']:.0f} "
           f"(blocks by type {info['blocks_gathered_by_type']}), summed reward {total_reward:.1f}, "
