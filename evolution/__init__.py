@@ -1,0 +1,13 @@
+"""Co-evolution of robot-team controllers and sensor morphologies on neat-python.
+
+Modules: ``substrate`` (HyperNEAT-M substrate and decoding), ``genome`` (the CPPN genome),
+``direct`` (NEAT-M: direct encoding with sensor genes), ``controller`` (the batched team
+controller), ``evaluate`` (a genome's trials through the env's public API), ``backends``
+(serial / process-pool evaluation), ``mods`` and ``pareto`` (NEAT-MODS multi-objective
+reproduction, NSGA-II sorting), ``trainer`` (the generation loop, statistics, checkpoints,
+champions), ``experiment`` (TOML experiment files), ``analysis`` and ``report`` (fronts,
+selection points, statistical tests, figures), ``cli`` (console scripts).
+"""
+
+__all__ = ["__version__"]
+__version__ = "0.1.0"
