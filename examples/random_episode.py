@@ -12,9 +12,9 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-from gathering_env.render import save_video
 
 from gathering_env import parallel_env
+from gathering_env.render import save_video
 
 
 def main() -> None:
