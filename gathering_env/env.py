@@ -50,7 +50,7 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 from pettingzoo.utils import wrappers
-from pettingzoo.utils.conversions import parallel_to_aec
+from pettingzoo.utils.conversions import parallel_to_aec_wrapper
 
 from .config import WorldConfig
 from .sensors import Morphology
@@ -247,9 +247,9 @@ def parallel_env(**kwargs: Any) -> GatheringEnv:
     return GatheringEnv(**kwargs)
 
 
-def raw_env(**kwargs: Any):
-    """The task as an AEC env, converted from the parallel env by PettingZoo."""
-    return parallel_to_aec(parallel_env(**kwargs))
+def raw_env(**kwargs: Any) -> parallel_to_aec_wrapper:
+    """The task as an AEC env (PettingZoo's parallel-to-AEC conversion, no wrappers)."""
+    return parallel_to_aec_wrapper(parallel_env(**kwargs))
 
 
 def env(**kwargs: Any):
