@@ -44,6 +44,9 @@ class WorldConfig:
     """Physics time step per environment step (s)."""
     physics_iterations: int = 10
     """pymunk solver iterations per step."""
+    physics_substeps: int = 1
+    """pymunk steps per environment step (each of dt / substeps); more = smaller contact
+    overlaps at a proportional cost."""
     max_cycles: int = 10_000
     """Steps per trial before truncation (SPEC: 10 000)."""
 
@@ -137,6 +140,7 @@ class WorldConfig:
         _check_int("num_robots", self.num_robots, 1, 1000)
         _check_int("max_cycles", self.max_cycles, 1, 10**9)
         _check_int("physics_iterations", self.physics_iterations, 1, 1000)
+        _check_int("physics_substeps", self.physics_substeps, 1, 100)
         for name in (
             "arena_width", "arena_height", "dt", "robot_radius", "robot_mass",
             "robot_max_speed", "robot_drive_force", "robot_drive_torque",

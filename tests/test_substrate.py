@@ -6,9 +6,9 @@ import math
 from pathlib import Path
 
 import neat
-from neat.innovation import InnovationTracker
 import numpy as np
 import pytest
+from neat.innovation import InnovationTracker
 
 from evolution.genome import CPPNGenome
 from evolution.substrate import Substrate, decode
