@@ -1,0 +1,154 @@
+"""Hand-placed sensor scenes: readings computed by hand from SPEC section 3."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gathering_env.config import WorldConfig
+from gathering_env.sensing import SensorBank
+from gathering_env.sensors import Morphology, SensorSpec
+
+R = 0.15  # robot radius
+
+
+def bank(sensors, blocks=((0.2, 1),), **cfg):
+    """A bank over a 40 x 40 arena with the given blocks ((half side, need), ...)."""
+    config = WorldConfig.from_kwargs(environment=None, block_counts=(max(len(blocks), 1), 0, 0),
+                                     num_robots=3, **cfg)
+    half = np.array([b[0] for b in blocks], dtype=float)
+    need = np.array([b[1] for b in blocks], dtype=float)
+    return SensorBank(Morphology(sensors), config, half, need)
+
+
+def read(b, robots, blocks=()):
+    """robots: [(x, y, angle)], blocks: [(x, y, angle)] -> (N, S) readings (float64)."""
+    rp = np.array([r[:2] for r in robots], dtype=float)
+    ra = np.array([r[2] for r in robots], dtype=float)
+    bp = np.array([q[:2] for q in blocks], dtype=float).reshape(-1, 2)
+    ba = np.array([q[2] for q in blocks], dtype=float)
+    return b.read(rp, ra, bp, ba).astype(float)
+
+
+FAR = (35.0, 35.0, 0.0)  # a robot far from everything
+IR = SensorSpec("infrared", 0.0, 0.0, 2.0, math.pi / 3)
+
+
+def test_infrared_block_straight_ahead():
+    # Robot at (20, 20) facing +x: mount at (20.15, 20). Block (half 0.2) centred at (21.35, 20):
+    # its near face is at x = 21.15 -> d = 1.0 -> reading 1 - 1/2 = 0.5.
+    b = bank([IR])
+    got = read(b, [(20, 20, 0.0), FAR, FAR[:2] + (1.0,)], [(21.35, 20, 0.0)])
+    assert got[0, 0] == pytest.approx(0.5)
+
+
+def test_infrared_robot_ahead_and_wall():
+    # Another robot centred 1.15 + 0.15 ahead of the mount: surface at d = 1.0 -> 0.5.
+    b = bank([IR])
+    got = read(b, [(20, 20, 0.0), (20.15 + 1.0 + R, 20, 2.0), FAR], [(5, 5, 0)])
+    assert got[0, 0] == pytest.approx(0.5)
+    # Facing the east wall (x = 40) from x = 38.85: mount at 39.0, d = 1 -> 0.5.
+    got = read(b, [(38.85, 20, 0.0), FAR, (30, 30, 0)], [(5, 5, 0)])
+    assert got[0, 0] == pytest.approx(0.5)
+
+
+def test_outside_range_fov_and_behind_read_zero():
+    b = bank([IR])
+    # Block face at d = 2.05 > range 2.
+    assert read(b, [(20, 20, 0.0), FAR, FAR], [(22.4, 20, 0.0)])[0, 0] == 0.0
+    # Block at 45 deg off-axis (fov/2 = 30 deg): nearest point outside the cone.
+    off = (20.15 + 1.0 * math.cos(math.pi / 4), 20 + 1.0 * math.sin(math.pi / 4))
+    assert read(b, [(20, 20, 0.0), FAR, FAR], [(off[0], off[1], 0.0)])[0, 0] == 0.0
+    # Just inside the cone (25 deg) it is seen.
+    inside = (20.15 + 1.3 * math.cos(math.radians(25)), 20 + 1.3 * math.sin(math.radians(25)))
+    assert read(b, [(20, 20, 0.0), FAR, FAR], [(inside[0], inside[1], 0.0)])[0, 0] > 0.0
+    # Behind the robot: nothing.
+    assert read(b, [(20, 20, 0.0), FAR, FAR], [(18.5, 20, 0.0)])[0, 0] == 0.0
+
+
+def test_bearing_and_orientation_rotate_the_cone():
+    block = [(20, 21.35, 0.0)]  # 1.35 north of the robot centre
+    left = SensorSpec("infrared", math.pi / 2, 0.0, 2.0, math.pi / 3)
+    b = bank([IR, left])
+    got = read(b, [(20, 20, 0.0), FAR, FAR], block)
+    assert got[0, 0] == 0.0                       # front sensor looks east
+    assert got[0, 1] == pytest.approx(0.5)        # bearing +90 deg: mount (20, 20.15), d = 1.0
+    # Turning the robot by +90 deg brings the block in front of the front sensor.
+    got = read(b, [(20, 20, math.pi / 2), FAR, FAR], block)
+    assert got[0, 0] == pytest.approx(0.5) and got[0, 1] == 0.0
+    # Orientation: a front-mounted sensor turned +90 deg looks north from its mount (20.15, 20);
+    # a block centred at (20.15, 21.2) has its south face at y = 21.0 -> d = 1.0.
+    turned = SensorSpec("infrared", 0.0, math.pi / 2, 2.0, math.pi / 3)
+    got = read(bank([turned]), [(20, 20, 0.0), FAR, FAR], [(20.15, 21.2, 0.0)])
+    assert got[0, 0] == pytest.approx(0.5)
+
+
+def test_rotated_block_nearest_point():
+    # A block rotated 45 deg presents a corner: centre at (21.15 + 0.2*sqrt2, 20) -> the corner
+    # is at x = 21.15, straight ahead of the mount at d = 1.0.
+    b = bank([IR])
+    got = read(b, [(20, 20, 0.0), FAR, FAR], [(21.15 + 0.2 * math.sqrt(2), 20, math.pi / 4)])
+    assert got[0, 0] == pytest.approx(0.5)
+
+
+def test_a_robot_never_sees_itself():
+    # Mounted at the front, turned to look north with a 180 deg cone: the robot's own centre lies
+    # on the cone's edge at distance 0.15 (surface 0), so only the self-exclusion keeps it at 0.
+    wide = SensorSpec("ultrasonic", 0.0, math.pi / 2, 0.5, math.pi)
+    got = read(bank([wide]), [(20, 20, 0.0), FAR, (35, 5, 0.0)], [(5, 35, 0.0)])
+    assert got[0, 0] == 0.0
+    # Another robot centred 0.2 north of the mount is seen: surface at d = 0.05 -> (1 - 0.1) / 0.95.
+    got = read(bank([wide]), [(20, 20, 0.0), (20.15, 20.2, 0.0), (35, 5, 0.0)], [(5, 35, 0.0)])
+    assert got[0, 0] == pytest.approx(0.9 / 0.95)
+
+
+def test_ultrasonic_profile():
+    us = SensorSpec("ultrasonic", 0.0, 0.0, 10.0, 0.5)
+    b = bank([us])
+    # d = 0.4 (within the first 5 % = 0.5) -> 1
+    assert read(b, [(20, 20, 0.0), FAR, FAR], [(20.15 + 0.4 + 0.2, 20, 0.0)])[0, 0] == pytest.approx(1.0)
+    # d = 5 -> (1 - 0.5) / 0.95
+    assert read(b, [(20, 20, 0.0), FAR, FAR], [(20.15 + 5 + 0.2, 20, 0.0)])[0, 0] == pytest.approx(0.5 / 0.95)
+
+
+def test_colour_sensor_bands():
+    col = SensorSpec("colour", 0.0, 0.0, 2.0, math.pi / 3)
+    b = bank([col])
+    block = read(b, [(20, 20, 0.0), FAR, FAR], [(21.35, 20, 0.0)])[0, 0]
+    assert block == pytest.approx(0.5 + 0.5 * 0.5)                 # block at d = 1
+    wall = read(b, [(38.85, 20, 0.0), FAR, FAR], [(5, 5, 0.0)])[0, 0]
+    assert wall == pytest.approx(0.5 * 0.5)                         # wall at d = 1
+    robot = read(b, [(20, 20, 0.0), (21.3, 20, 0.0), FAR], [(5, 5, 0.0)])[0, 0]
+    assert robot == 0.0                                             # robot -> 0
+    # the closest object decides: a robot in front of a block hides the block's colour
+    both = read(b, [(20, 20, 0.0), (20.7, 20, 0.0), FAR], [(21.8, 20, 0.0)])[0, 0]
+    assert both == 0.0
+
+
+def test_camera_cooperation_ratio():
+    cam = SensorSpec("camera", 0.0, 0.0, 10.0, 1.0)
+    b = bank([cam], blocks=((0.4, 3), (0.3, 2)))
+    # One large block (needs 3) ahead, one other robot in view: R = 1 + 1 = 2, Q = 3 -> 2/3.
+    got = read(b, [(20, 20, 0.0), (23, 20.2, 0.0), FAR], [(25, 20, 0.0), (5, 5, 0.0)])
+    assert got[0, 0] == pytest.approx(2 / 3)
+    # Both blocks in view: Q = 5 -> 2/5.
+    got = read(b, [(20, 20, 0.0), (23, 20.2, 0.0), FAR], [(25, 20, 0.0), (27, 19.8, 0.0)])
+    assert got[0, 0] == pytest.approx(2 / 5)
+    # Enough robots already (R > Q): 0. No blocks in view: 0.
+    b1 = bank([cam], blocks=((0.2, 1),))
+    assert read(b1, [(20, 20, 0.0), (23, 20.2, 0.0), FAR], [(25, 20, 0.0)])[0, 0] == 0.0
+    assert read(b1, [(20, 20, 0.0), (23, 20.2, 0.0), FAR], [(5, 5, 0.0)])[0, 0] == 0.0
+
+
+def test_bottom_sensor_over_and_near_the_zone():
+    b = bank([SensorSpec("bottom")])  # zone x 10..30, y 0..8, falloff 1 unit
+    got = read(b, [(20, 4, 0.0), (20, 8.5, 0.0), (20, 9.5, 0.0)], [(35, 35, 0.0)])
+    np.testing.assert_allclose(got[:, 0], [1.0, 0.5, 0.0])
+
+
+def test_ir_gamma_response():
+    b = bank([IR], ir_response="gamma", ir_gamma=2.0)
+    got = read(b, [(20, 20, 0.0), FAR, FAR], [(21.35, 20, 0.0)])
+    assert got[0, 0] == pytest.approx(0.25)      # (1 - 1/2) ** 2
