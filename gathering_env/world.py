@@ -292,7 +292,7 @@ class GatheringWorld:
             normal_angle = self.block_angle[block] + math.atan2(*_SIDE_NORMALS[side][::-1])
             outward = np.array([math.cos(normal_angle), math.sin(normal_angle)])
             robot_body.position = tuple(point + outward * cfg.robot_radius)
-            robot_body.angle = normal_angle + math.pi
+            robot_body.angle = math.remainder(normal_angle + math.pi, 2 * math.pi)
             robot_body.velocity = (0.0, 0.0)
             robot_body.angular_velocity = 0.0
             self.space.reindex_shapes_for_body(robot_body)

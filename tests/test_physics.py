@@ -187,3 +187,34 @@ def test_long_run_has_no_nan():
     assert sim.steps == 10_000 or terminated
     assert np.isfinite(obs).all() and np.isfinite(sim.world.robot_pos).all() and np.isfinite(sim.world.block_pos).all()
     assert np.all((sim.world.robot_pos > 0) & (sim.world.robot_pos < 40))
+
+
+def test_collision_avoidance_turns_away_from_a_wall():
+    def run(avoid: bool) -> tuple[float, float]:
+        sim = one_block_world(0, 1, pickup_heuristic=False, collision_avoidance=avoid)
+        w = sim.world
+        w.place_block(0, 5.0, 5.0, 0.0)
+        w.place_robot(0, 20.0, 39.5, math.pi / 2)        # facing the north wall, 0.35 away
+        highest = 0.0
+        for _ in range(12):
+            sim.step(np.array([[1.0, 1.0]]))
+            highest = max(highest, w.robot_pos[0, 1])
+        return w.robot_angle[0], highest
+
+    angle_off, y_off = run(False)
+    angle_on, y_on = run(True)
+    assert angle_off == pytest.approx(math.pi / 2, abs=1e-6) and y_off > 39.8   # drives into the wall
+    assert abs(angle_on - math.pi / 2) > 0.5 and y_on < 39.8                     # turned away in time
+
+
+def test_pickup_positioning_snaps_onto_the_anchor():
+    sim = one_block_world(0, 1, pickup_positioning=True)
+    w, cfg = sim.world, sim.config
+    w.place_block(0, 20.0, 30.0, 0.0)
+    # Slightly off-centre and skewed, touching the north face (y = 30.2).
+    w.place_robot(0, 20.03, 30.2 + cfg.robot_radius + 0.01, -math.pi / 2 + 0.2)
+    sim.step(np.zeros((1, 2)))
+    assert w.robot_attached[0] == 0
+    # Snapped: facing south (onto the side's normal), centred on the single anchor (x = 20).
+    assert w.robot_angle[0] == pytest.approx(-math.pi / 2, abs=0.05)
+    assert w.robot_pos[0, 0] == pytest.approx(20.0, abs=0.02)

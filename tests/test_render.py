@@ -62,3 +62,16 @@ def test_save_video(tmp_path, env):
         save_video(frames, tmp_path / "ep.avi")
     with pytest.raises(ValueError, match="no frames"):
         save_video([], tmp_path / "ep.gif")
+
+
+def test_human_mode_draws_into_a_window():
+    # SDL's dummy video driver (set in conftest) gives a real, invisible pygame window.
+    e = parallel_env(environment=1, max_cycles=5, render_mode="human")
+    e.reset(seed=0)
+    e.step({a: np.zeros(2) for a in e.agents})
+    assert e.render() is None
+    import pygame
+
+    assert pygame.display.get_surface() is not None
+    assert pygame.display.get_surface().get_size() == (640, 640)
+    e.close()
