@@ -13,7 +13,7 @@ $(PY):
 
 $(STAMP): pyproject.toml | $(PY)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[dev,video]"
+	$(PY) -m pip install --quiet -e ".[dev,video,ray]"
 	touch $(STAMP)
 
 test: $(STAMP)

@@ -1,24 +1,34 @@
-"""Where genomes are evaluated: in this process (``serial``) or a local process pool.
+"""Where genomes are evaluated: ``serial``, a local ``process`` pool, or a ``ray`` cluster.
 
-Both return results in the order of the genomes they were given, and every result
-depends only on (genome, run seed, generation), so serial and parallel runs of the same
-seed give identical statistics. Each worker builds its environment once and reuses it.
+Every backend returns results in the order of the genomes it was given, and every result
+depends only on (genome, run seed, generation), so all backends give identical statistics
+for the same seed. Each worker builds its environment once and reuses it
+(``evolution.evaluate`` keeps one env per process).
+
+Faults: an evaluation that raises, or a worker process that dies, is retried up to
+``max_retries`` times; a genome that keeps failing gets the worst objectives
+(``Evaluation.failure``) and its error is reported with the genome id, and the run goes on.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
+import traceback
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 from .evaluate import Evaluation, evaluate
+
+BACKENDS = ("serial", "process", "ray")
 
 
 @dataclass(frozen=True)
 class EvalContext:
-    """What every evaluation of a run shares (pickled once per worker)."""
+    """What every evaluation of a run shares (sent once per worker)."""
 
     neat_config: Any
     env_config: dict[str, Any]
@@ -33,16 +43,41 @@ class EvalContext:
                         generation=generation, method=self.method, substrate=self.substrate)
 
 
+class Evaluator(Protocol):
+    name: str
+    failures: list[tuple[int, str]]
+
+    def map(self, genomes: list[Any], generation: int) -> list[Evaluation]: ...
+
+    def close(self) -> None: ...
+
+
+def _describe(err: BaseException) -> str:
+    return "".join(traceback.format_exception_only(type(err), err)).strip()
+
+
 class SerialEvaluator:
     """Evaluate genomes one after another in this process."""
 
     name = "serial"
 
-    def __init__(self, context: EvalContext) -> None:
+    def __init__(self, context: EvalContext, max_retries: int = 2) -> None:
         self.context = context
+        self.max_retries = max_retries
+        self.failures: list[tuple[int, str]] = []
 
     def map(self, genomes: list[Any], generation: int) -> list[Evaluation]:
-        return [self.context.evaluate(g, generation) for g in genomes]
+        results = []
+        for g in genomes:
+            for attempt in range(self.max_retries + 1):
+                try:
+                    results.append(self.context.evaluate(g, generation))
+                    break
+                except Exception as err:  # noqa: BLE001 - any evaluation error is retried, then recorded
+                    if attempt == self.max_retries:
+                        self.failures.append((g.key, _describe(err)))
+                        results.append(Evaluation.failure(_describe(err)))
+        return results
 
     def close(self) -> None:
         pass
@@ -55,39 +90,137 @@ def _init_worker(context: EvalContext) -> None:
     global _WORKER_CONTEXT
     _WORKER_CONTEXT = context
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    # Ctrl-C reaches the whole process group: the trainer decides what to do, not the workers.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _evaluate_in_worker(args: tuple[Any, int]) -> Evaluation:
-    genome, generation = args
+def _evaluate_in_worker(genome: Any, generation: int, attempt: int) -> Evaluation:
     assert _WORKER_CONTEXT is not None, "worker not initialised"
+    os.environ["GATHERING_EVAL_ATTEMPT"] = str(attempt)  # visible to fault-injection tests
     return _WORKER_CONTEXT.evaluate(genome, generation)
 
 
 class ProcessEvaluator:
-    """Evaluate genomes on ``workers`` local processes (results in submission order)."""
+    """Evaluate genomes on ``workers`` local processes.
+
+    A worker that dies breaks the pool: the pool is rebuilt and the unfinished genomes are
+    submitted again (each such restart counts as an attempt for every genome in flight).
+    """
 
     name = "process"
 
-    def __init__(self, context: EvalContext, workers: int) -> None:
+    def __init__(self, context: EvalContext, workers: int, max_retries: int = 2) -> None:
         if workers < 1:
             raise ValueError(f"workers={workers}; allowed: >= 1")
         self.context = context
         self.workers = workers
-        ctx = multiprocessing.get_context("fork" if hasattr(os, "fork") else "spawn")
-        self._pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
-                                         initializer=_init_worker, initargs=(context,))
+        self.max_retries = max_retries
+        self.failures: list[tuple[int, str]] = []
+        self._ctx = multiprocessing.get_context("fork" if hasattr(os, "fork") else "spawn")
+        self._pool = self._new_pool()
+
+    def _new_pool(self) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(max_workers=self.workers, mp_context=self._ctx,
+                                   initializer=_init_worker, initargs=(self.context,))
 
     def map(self, genomes: list[Any], generation: int) -> list[Evaluation]:
-        return list(self._pool.map(_evaluate_in_worker, [(g, generation) for g in genomes], chunksize=1))
+        results: list[Evaluation | None] = [None] * len(genomes)
+        attempts = [0] * len(genomes)
+        pending = list(range(len(genomes)))
+        while pending:
+            futures = {i: self._pool.submit(_evaluate_in_worker, genomes[i], generation, attempts[i]) for i in pending}
+            retry: list[int] = []
+            broken = False
+            for i, fut in futures.items():
+                try:
+                    results[i] = fut.result()
+                    continue
+                except BrokenProcessPool as err:
+                    broken, error = True, f"worker process died: {_describe(err)}"
+                except Exception as err:  # noqa: BLE001 - evaluation errors come back from the worker
+                    error = _describe(err)
+                attempts[i] += 1
+                if attempts[i] > self.max_retries:
+                    self.failures.append((genomes[i].key, error))
+                    results[i] = Evaluation.failure(error)
+                else:
+                    retry.append(i)
+            if broken:
+                self._pool.shutdown(wait=False, cancel_futures=True)
+                self._pool = self._new_pool()
+            pending = retry
+        return results  # type: ignore[return-value]
 
     def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)
 
 
-def make_evaluator(context: EvalContext, workers: int | None) -> SerialEvaluator | ProcessEvaluator:
-    """``workers`` = 1 -> serial; None -> all local cores; N > 1 -> a pool of N processes."""
+class RayEvaluator:
+    """Evaluate genomes as Ray tasks (a local Ray, or a cluster at ``address``).
+
+    The context is put into Ray's object store once; each task resolves it and evaluates one
+    genome; Ray retries tasks whose worker died and, with ``retry_exceptions``, tasks that
+    raised, up to ``max_retries`` times. Results are collected in submission order.
+    """
+
+    name = "ray"
+
+    def __init__(self, context: EvalContext, address: str | None = None, num_cpus: int | None = None,
+                 max_retries: int = 2) -> None:
+        try:
+            import ray
+        except ImportError:
+            raise ValueError("the ray backend needs Ray: pip install 'gathering-evolution[ray]' "
+                             "(or pip install ray)") from None
+        self._ray = ray
+        self.failures: list[tuple[int, str]] = []
+        self._own = not ray.is_initialized()
+        if self._own:
+            kwargs: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False,
+                                      "configure_logging": False}
+            if address:
+                kwargs["address"] = address
+            elif num_cpus:
+                kwargs["num_cpus"] = num_cpus
+            ray.init(**kwargs)
+        self._context_ref = ray.put(context)
+        self._task = ray.remote(_ray_evaluate).options(max_retries=max_retries, retry_exceptions=True)
+
+    def map(self, genomes: list[Any], generation: int) -> list[Evaluation]:
+        refs = [self._task.remote(self._context_ref, g, generation) for g in genomes]
+        results = []
+        for g, ref in zip(genomes, refs):
+            try:
+                results.append(self._ray.get(ref))
+            except Exception as err:  # noqa: BLE001 - RayTaskError / WorkerCrashedError after retries
+                error = _describe(err).splitlines()[-1]
+                self.failures.append((g.key, error))
+                results.append(Evaluation.failure(error))
+        return results
+
+    def close(self) -> None:
+        if self._own and self._ray.is_initialized():
+            self._ray.shutdown()
+
+
+def _ray_evaluate(context: EvalContext, genome: Any, generation: int) -> Evaluation:
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    return context.evaluate(genome, generation)
+
+
+def make_evaluator(context: EvalContext, workers: int | None, backend: str = "process",
+                   ray_address: str | None = None, max_retries: int = 2) -> Evaluator:
+    """An evaluator for ``backend`` ('serial', 'process' or 'ray').
+
+    ``workers``: processes for 'process' (None = all local cores; 1 falls back to serial),
+    CPUs of a locally started Ray for 'ray'.
+    """
+    if backend not in BACKENDS:
+        raise ValueError(f"backend={backend!r}; allowed: {list(BACKENDS)}")
     if workers is None:
         workers = os.cpu_count() or 1
-    if workers <= 1:
-        return SerialEvaluator(context)
-    return ProcessEvaluator(context, workers)
+    if backend == "ray":
+        return RayEvaluator(context, address=ray_address, num_cpus=workers, max_retries=max_retries)
+    if backend == "serial" or workers <= 1:
+        return SerialEvaluator(context, max_retries=max_retries)
+    return ProcessEvaluator(context, workers, max_retries=max_retries)

@@ -34,6 +34,10 @@ def evolve_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--resume", action="store_true", help="continue the run in --out from its newest checkpoint")
     parser.add_argument("--resume-from", type=Path, help="continue from this checkpoint file")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--backend", choices=("serial", "process", "ray"), default="process",
+                        help="where genomes are evaluated (default: process pool)")
+    parser.add_argument("--ray-address", help="join this Ray cluster (e.g. 'auto' or 'head:6379') instead of a local Ray")
+    parser.add_argument("--max-retries", type=int, default=2, help="retries of a failing evaluation (default 2)")
     group = parser.add_argument_group("overrides of the experiment file")
     group.add_argument("--name")
     group.add_argument("--method", choices=METHODS)
@@ -56,18 +60,26 @@ def evolve_main(argv: list[str] | None = None) -> int:
     }
     if args.workers is not None and args.workers < 1:
         return _fail(f"--workers={args.workers}; allowed: >= 1")
+    if args.max_retries < 0:
+        return _fail(f"--max-retries={args.max_retries}; allowed: >= 0")
     try:
         experiment = load_experiment(args.experiment, overrides)
         out = args.out or Path("runs") / f"{experiment.name}-seed{experiment.seed}"
         from .trainer import Trainer
 
         trainer = Trainer(experiment, out, workers=args.workers, resume=args.resume,
-                          resume_from=args.resume_from, progress=not args.no_progress)
+                          resume_from=args.resume_from, progress=not args.no_progress,
+                          backend=args.backend, ray_address=args.ray_address, max_retries=args.max_retries)
         result = trainer.run()
     except (ExperimentError, CheckpointError) as err:
         return _fail(str(err))
+    except ValueError as err:  # e.g. the ray backend without Ray installed
+        return _fail(str(err))
     except KeyboardInterrupt:
         print("\ninterrupted: resume with --resume", file=sys.stderr)
+        return 130
+    if result.interrupted:
+        print(f"stopped after {result.generations} generations; resume with: gathering-evolve ... --out {out} --resume")
         return 130
     status = "converged" if result.converged else "finished"
     print(f"{status}: {result.generations} generations, best ft {result.best_task:.2f}")

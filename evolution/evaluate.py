@@ -67,6 +67,16 @@ class Evaluation:
     seconds_controller: float = 0.0
     seconds_decode: float = 0.0
 
+    failed: bool = False
+    error: str = ""
+
+    @classmethod
+    def failure(cls, error: str) -> Evaluation:
+        """The worst outcome, for a genome whose evaluation kept failing: every objective 0
+        (ft's minimum, the simplicity of ten full sensors, a controller of 100 links)."""
+        return cls(task=0.0, morphology=0.0, controller=0.0, sensors=sensor_statistics(Morphology()),
+                   failed=True, error=error)
+
     def objectives(self, names: tuple[str, ...]) -> tuple[float, ...]:
         return tuple(float(getattr(self, n)) for n in names)
 

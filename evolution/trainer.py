@@ -96,6 +96,7 @@ class RunResult:
     best_task: float
     champion: Path | None
     converged: bool
+    interrupted: bool = False
 
 
 class Trainer:
@@ -106,16 +107,27 @@ class Trainer:
         workers: evaluation processes (None = all local cores, 1 = serial).
         resume: continue from the newest checkpoint in ``run_dir`` (or ``resume_from``).
         progress: show a progress bar with ETA (tqdm).
+        backend: 'serial', 'process' or 'ray' (``evolution.backends``); ray_address: join this
+            Ray cluster instead of starting a local one. max_retries: per failing evaluation.
+
+    SIGINT/SIGTERM: the first signal lets the current generation finish (its statistics and
+    checkpoint are written) and then stops; a second one abandons the generation at once. Either
+    way the run resumes from its last checkpoint.
     """
 
     def __init__(self, experiment: Experiment, run_dir: Path, workers: int | None = None,
-                 resume: bool = False, resume_from: Path | None = None, progress: bool = True) -> None:
+                 resume: bool = False, resume_from: Path | None = None, progress: bool = True,
+                 backend: str = "process", ray_address: str | None = None, max_retries: int = 2) -> None:
         self.experiment = experiment
         self.run_dir = Path(run_dir)
         self.workers = workers
         self.resume = resume or resume_from is not None
         self.resume_from = resume_from
         self.progress = progress
+        self.backend = backend
+        self.ray_address = ray_address
+        self.max_retries = max_retries
+        self.stop_requested = False
         self.stats_path = self.run_dir / "stats.jsonl"
         self.champion_path = self.run_dir / "champion.json"
         self.best: tuple[float, int] | None = None  # (task, genome key)
@@ -197,7 +209,13 @@ class Trainer:
         exp = self.experiment
         population = self._prepare()
         context = EvalContext(self.config, dict(exp.environment), exp.trials, exp.seed, exp.method, self.substrate)
-        evaluator = self._evaluator = make_evaluator(context, self.workers)
+        # Starting a backend (Ray in particular) may draw from Python's global random generator,
+        # which is neat-python's: keep the lineage independent of the backend.
+        random_state = random.getstate()
+        evaluator = self._evaluator = make_evaluator(context, self.workers, self.backend, self.ray_address,
+                                                     self.max_retries)
+        random.setstate(random_state)
+        previous_handlers = self._install_signal_handlers()
         bar = None
         if self.progress:
             from tqdm import tqdm
@@ -226,7 +244,10 @@ class Trainer:
                 if (exp.convergence_stop and not exp.multi_objective and record["task_best"] >= target):
                     converged = True
                     break
+                if self.stop_requested:
+                    break
         finally:
+            self._restore_signal_handlers(previous_handlers)
             evaluator.close()
             if bar is not None:
                 bar.close()
@@ -235,12 +256,44 @@ class Trainer:
         self._plot()
         records = read_stats(self.stats_path)
         return RunResult(self.run_dir, len(records), max((r["task_best"] for r in records), default=0.0),
-                         self.champion_path if self.champion_path.exists() else None, converged)
+                         self.champion_path if self.champion_path.exists() else None, converged,
+                         interrupted=self.stop_requested)
+
+    def _install_signal_handlers(self) -> dict[int, Any]:
+        import signal
+        import threading
+
+        if threading.current_thread() is not threading.main_thread():
+            return {}
+
+        def request_stop(signum: int, frame: Any) -> None:
+            if self.stop_requested:
+                raise KeyboardInterrupt  # second signal: abandon the generation in flight
+            self.stop_requested = True
+            print(f"\nsignal {signum}: finishing generation {getattr(self, '_generation', 0)}, then stopping "
+                  "(again to abandon it); resume with --resume", flush=True)
+
+        previous = {}
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            previous[sig] = signal.signal(sig, request_stop)
+        return previous
+
+    @staticmethod
+    def _restore_signal_handlers(previous: dict[int, Any]) -> None:
+        import signal
+
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
     def _fitness(self, genomes: list[tuple[int, Any]], config: neat.Config) -> None:
         """neat-python fitness function: evaluate on the backend, set fitness and objectives."""
         evaluations = self._evaluator.map([g for _, g in genomes], self._generation)
         self._current = {}
+        for key, error in self._evaluator.failures:
+            with open(self.run_dir / "errors.log", "a", encoding="utf-8") as log:
+                log.write(f"generation {self._generation} genome {key}: {error}\n")
+        self._failures = len(self._evaluator.failures)
+        self._evaluator.failures.clear()
         for (key, g), ev in zip(genomes, evaluations):
             g.fitness = ev.task
             g.objectives = ev.objectives(self.experiment.objectives)
@@ -251,6 +304,7 @@ class Trainer:
         evaluations = list(self._current.values())
         best_key = max(self._current, key=lambda k: (self._current[k].task, -k))
         record = generation_record(generation, evaluations, species_count, seconds, best_key)
+        record["failures"] = int(getattr(self, "_failures", 0))
         best_task = self._current[best_key].task
         if self.best is None or best_task > self.best[0]:
             self.best = (best_task, best_key)
