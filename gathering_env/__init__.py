@@ -9,9 +9,11 @@ Public names::
 
 Importing the package registers ``gathering_env/CollectiveGathering-v0`` in PettingZoo's
 registry: ``pettingzoo.make("parallel", "gathering_env/CollectiveGathering-v0", environment=2)``
-(and ``"aec"``).
+(and ``"aec"``), and the centralised single-agent form in Gymnasium's:
+``gymnasium.make("gathering_env/GatheringTeam-v0", environment=2)``.
 """
 
+import gymnasium as _gymnasium
 from pettingzoo import register as _register
 
 from .config import ENVIRONMENT_PRESETS, WorldConfig
@@ -19,13 +21,17 @@ from .env import GatheringEnv, env, parallel_env, raw_env
 from .sensors import SENSOR_TYPES, Morphology, SensorSpec, morphological_complexity
 
 ENV_ID = "gathering_env/CollectiveGathering-v0"
+TEAM_ENV_ID = "gathering_env/GatheringTeam-v0"
 
 _register("parallel", ENV_ID, entry_point="gathering_env.env:parallel_env")
 _register("aec", ENV_ID, entry_point="gathering_env.env:env")
+if TEAM_ENV_ID not in _gymnasium.registry:
+    _gymnasium.register(TEAM_ENV_ID, entry_point="gathering_env.team_env:GatheringTeamEnv")
 
 __all__ = [
     "ENVIRONMENT_PRESETS",
     "ENV_ID",
+    "TEAM_ENV_ID",
     "SENSOR_TYPES",
     "GatheringEnv",
     "Morphology",

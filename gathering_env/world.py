@@ -51,6 +51,19 @@ class GatheringWorld:
         self.config = config
         self.space: pymunk.Space | None = None
 
+    def __getstate__(self) -> dict:
+        """Picklable (pymunk spaces pickle; the batch buffers are recreated)."""
+        state = dict(self.__dict__)
+        state.pop("_buf", None)
+        state.pop("_set_buf", None)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        if self.space is not None:
+            self._buf = pbatch.Buffer()
+            self._set_buf = pbatch.Buffer()
+
     # ------------------------------------------------------------------ construction
     def reset(self, rng: np.random.Generator) -> None:
         """Build a fresh world with positions and headings drawn from ``rng``."""

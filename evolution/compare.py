@@ -1,0 +1,209 @@
+"""Compare team policies on the same seeds: random, a fixed search pattern, evolved champions, PPO.
+
+``gathering-compare --policy random --policy heuristic --policy champion:run/champion.json
+--policy ppo:ppo/model.zip --environment 2 --episodes 5 --out compare/`` runs every policy on
+the same environment and episode seeds and writes ``compare.md`` / ``compare.csv`` (mean +- std
+ft, blocks gathered by type, time to finish) and ``compare.png`` (a bar plot).
+
+Policies (each carries the morphology it was made for):
+
+* ``random``: uniform random wheel commands (Khepera III morphology).
+* ``heuristic``: the pickup heuristic with a fixed search pattern on Khepera III readings:
+  drive forward on a slight curve, turn on the spot while the front ultrasonic or either
+  infrared sensor reports an obstacle close ahead.
+* ``champion:PATH``: an evolved team from a champion JSON (its own morphology).
+* ``ppo:PATH``: a Stable-Baselines3 PPO model (``examples/rl_ppo.py``) with the morphology
+  saved next to it (``PATH`` with suffix ``.morphology.json``), Khepera III if absent.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gathering_env import Morphology, parallel_env
+
+
+@dataclass
+class Policy:
+    """A named team policy: ``act(obs (N, S)) -> wheels (N, 2)`` for its morphology."""
+
+    name: str
+    morphology: Morphology
+    act: Any
+    reset: Any = field(default=lambda seed: None)
+
+
+def random_policy() -> Policy:
+    state = {"rng": np.random.default_rng(0)}
+
+    def act(obs):
+        return state["rng"].uniform(-1.0, 1.0, (obs.shape[0], 2))
+
+    def reset(seed):
+        state["rng"] = np.random.default_rng(seed)
+
+    return Policy("random", Morphology.khepera_iii(), act, reset)
+
+
+def heuristic_policy() -> Policy:
+    """Search pattern on Khepera III readings (bottom, IR +40, IR -40, US 0, US +90, US -90)."""
+
+    def act(obs):
+        wheels = np.tile([1.0, 0.85], (obs.shape[0], 1))
+        blocked = (obs[:, 3] > 0.75) | (obs[:, 1] > 0.0) | (obs[:, 2] > 0.0)
+        wheels[blocked] = [1.0, -1.0]
+        return wheels
+
+    return Policy("heuristic", Morphology.khepera_iii(), act)
+
+
+def champion_policy(path: str) -> Policy:
+    from .champion import load_champion
+
+    champion = load_champion(path)
+    return Policy(f"champion:{Path(path).parent.name or path}", champion.morphology, champion.controller.act)
+
+
+def ppo_policy(path: str) -> Policy:
+    try:
+        from stable_baselines3 import PPO
+    except ImportError:
+        raise ValueError("ppo policies need Stable-Baselines3: pip install 'gathering-evolution[rl]'") from None
+    model_path = Path(path)
+    if not model_path.exists():
+        raise ValueError(f"{model_path}: PPO model not found")
+    morph_path = model_path.with_suffix(".morphology.json")
+    morphology = (Morphology.from_dict(json.loads(morph_path.read_text())) if morph_path.exists()
+                  else Morphology.khepera_iii())
+    model = PPO.load(str(model_path), device="cpu")
+    expected = model.observation_space.shape
+    if expected != (len(morphology),):
+        raise ValueError(f"{model_path}: the policy expects observations of shape {expected}, but its morphology "
+                         f"has {len(morphology)} sensors; save the morphology as {morph_path.name}")
+
+    def act(obs):
+        action, _ = model.predict(obs.astype(np.float32), deterministic=True)
+        return np.asarray(action, dtype=np.float64).reshape(obs.shape[0], 2)
+
+    return Policy(f"ppo:{model_path.stem}", morphology, act)
+
+
+def make_policy(spec: str) -> Policy:
+    kind, _, arg = spec.partition(":")
+    if kind == "random" and not arg:
+        return random_policy()
+    if kind == "heuristic" and not arg:
+        return heuristic_policy()
+    if kind == "champion" and arg:
+        return champion_policy(arg)
+    if kind == "ppo" and arg:
+        return ppo_policy(arg)
+    raise ValueError(f"policy {spec!r}; allowed: random, heuristic, champion:PATH, ppo:PATH")
+
+
+def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
+    obs_dict, _ = env.reset(seed=seed, options={"morphology": policy.morphology})
+    policy.reset(seed)
+    obs = np.stack([obs_dict[a] for a in env.possible_agents])
+    if obs.shape[1] != len(policy.morphology):
+        raise ValueError(f"policy {policy.name}: observation width {obs.shape[1]} != {len(policy.morphology)}")
+    terminated = truncated = False
+    while not (terminated or truncated):
+        wheels = np.asarray(policy.act(obs), dtype=np.float64)
+        if wheels.shape != (obs.shape[0], 2):
+            raise ValueError(f"policy {policy.name} returned actions of shape {wheels.shape}; "
+                             f"expected ({obs.shape[0]}, 2)")
+        obs, _, terminated, truncated = env.step_batch(wheels)
+    info = env.team_info()
+    return {"ft": info["task_performance"], "by_type": info["blocks_gathered_by_type"],
+            "finished": terminated, "steps": info["steps"]}
+
+
+def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]) -> list[dict[str, Any]]:
+    """One row per policy: mean/std ft, mean blocks by type, mean steps to finish, finished count."""
+    env = parallel_env(**env_config)
+    rows = []
+    for policy in policies:
+        episodes = [run_episode(env, policy, s) for s in seeds]
+        ft = np.array([e["ft"] for e in episodes])
+        by_type = np.array([e["by_type"] for e in episodes], dtype=float)
+        done = [e["steps"] for e in episodes if e["finished"]]
+        rows.append({
+            "policy": policy.name, "sensors": len(policy.morphology), "episodes": len(seeds),
+            "ft_mean": float(ft.mean()), "ft_std": float(ft.std()),
+            "small": float(by_type[:, 0].mean()), "medium": float(by_type[:, 1].mean()),
+            "large": float(by_type[:, 2].mean()),
+            "finished": len(done), "steps_to_finish": float(np.mean(done)) if done else None,
+        })
+    return rows
+
+
+def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Path, Path, Path]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out.mkdir(parents=True, exist_ok=True)
+    csv_path = out / "compare.csv"
+    with open(csv_path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    lines = ["| policy | sensors | ft (mean ± std) | small | medium | large | finished | steps to finish |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        steps = f"{r['steps_to_finish']:.0f}" if r["steps_to_finish"] is not None else "—"
+        lines.append(f"| {r['policy']} | {r['sensors']} | {r['ft_mean']:.2f} ± {r['ft_std']:.2f} | {r['small']:.1f} | "
+                     f"{r['medium']:.1f} | {r['large']:.1f} | {r['finished']}/{r['episodes']} | {steps} |")
+    md_path = out / "compare.md"
+    md_path.write_text(f"{title}\n\n" + "\n".join(lines) + "\n")
+    fig, ax = plt.subplots(figsize=(1.6 + 1.3 * len(rows), 3.6), constrained_layout=True)
+    ax.bar(range(len(rows)), [r["ft_mean"] for r in rows], yerr=[r["ft_std"] for r in rows], capsize=4,
+           color="tab:blue")
+    ax.set_xticks(range(len(rows)), [r["policy"] for r in rows], rotation=15, fontsize=8)
+    ax.set_ylabel("task performance ft")
+    ax.set_title(title, fontsize=9)
+    png_path = out / "compare.png"
+    fig.savefig(png_path, dpi=110)
+    plt.close(fig)
+    return md_path, csv_path, png_path
+
+
+def compare_main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="gathering-compare", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--policy", action="append", required=True,
+                        help="random | heuristic | champion:PATH | ppo:PATH (repeat)")
+    parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3))
+    parser.add_argument("--steps", type=int, default=10_000, help="max_cycles per episode")
+    parser.add_argument("--robots", type=int, default=20)
+    parser.add_argument("--episodes", type=int, default=5, help="episodes (seeds 0..n-1) per policy")
+    parser.add_argument("--seed", type=int, default=0, help="first episode seed")
+    parser.add_argument("--out", type=Path, default=Path("compare"))
+    args = parser.parse_args(argv)
+    try:
+        policies = [make_policy(p) for p in args.policy]
+        env_config = {"environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots}
+        rows = compare(policies, env_config, list(range(args.seed, args.seed + args.episodes)))
+    except ValueError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    title = (f"environment {args.environment}, {args.robots} robots, {args.steps} steps, "
+             f"{args.episodes} episodes (seeds {args.seed}..{args.seed + args.episodes - 1})")
+    md, csv_path, png = write_outputs(rows, args.out, title)
+    print(md.read_text())
+    print(f"wrote {md}, {csv_path}, {png}")
+    return 0
+
+
+def run_compare() -> None:
+    sys.exit(compare_main())
