@@ -98,6 +98,7 @@ def replay_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("team.gif"), help=".gif or .mp4")
     parser.add_argument("--frame-every", type=int, default=10, help="record every k-th step")
     parser.add_argument("--fps", type=int, default=15)
+    parser.add_argument("--png", type=Path, help="also save the last frame as a PNG picture")
     args = parser.parse_args(argv)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     from .champion import ChampionError, load_champion
@@ -110,7 +111,8 @@ def replay_main(argv: list[str] | None = None) -> int:
             env_config["environment"] = args.environment
         if args.steps is not None:
             env_config["max_cycles"] = args.steps
-        info, path, frames = replay(champion, env_config, args.seed, args.out, args.frame_every, args.fps)
+        info, path, frames = replay(champion, env_config, args.seed, args.out, args.frame_every, args.fps,
+                                    png=args.png)
     except ChampionError as err:
         return _fail(str(err))
     except ValueError as err:
