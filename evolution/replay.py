@@ -6,9 +6,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from gathering_env.render import save_video
 
 from gathering_env import parallel_env
+from gathering_env.render import save_video
 
 from .champion import Champion
 
