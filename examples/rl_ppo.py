@@ -26,6 +26,7 @@ import supersuit as ss
 from stable_baselines3 import PPO
 from stable_baselines3.common.logger import configure
 from stable_baselines3.common.utils import set_random_seed
+from stable_baselines3.common.vec_env import VecMonitor
 
 from evolution.compare import compare, ppo_policy
 from gathering_env import Morphology, parallel_env
@@ -63,6 +64,7 @@ def main() -> None:
     env.reset(seed=args.seed)
     vec_env = ss.pettingzoo_env_to_vec_env_v1(env)
     vec_env = ss.concat_vec_envs_v1(vec_env, 1, num_cpus=0, base_class="stable_baselines3")
+    vec_env = VecMonitor(vec_env)  # episode return/length in the logs (rollout/ep_rew_mean)
     set_random_seed(args.seed)  # numpy, torch, python
 
     # 3. PPO with one shared policy; logs to stdout, CSV (and TensorBoard when available).
