@@ -93,7 +93,9 @@ def ppo_policy(path: str) -> Policy:
         action, _ = model.predict(obs.astype(np.float32), deterministic=True)
         return np.asarray(action, dtype=np.float64).reshape(obs.shape[0], 2)
 
-    return Policy(f"ppo:{model_path.stem}", morphology, act)
+    # SB3 saves "model.zip" by default: name such a model after its run directory instead.
+    label = model_path.parent.name if model_path.stem == "model" and model_path.parent.name else model_path.stem
+    return Policy(f"ppo:{label}", morphology, act)
 
 
 def make_policy(spec: str) -> Policy:
@@ -131,13 +133,16 @@ def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]
     """One row per policy: mean/std ft, mean blocks by type, mean steps to finish, finished count."""
     env = parallel_env(**env_config)
     rows = []
+    seen: dict[str, int] = {}
     for policy in policies:
+        seen[policy.name] = seen.get(policy.name, 0) + 1
+        name = policy.name if seen[policy.name] == 1 else f"{policy.name}#{seen[policy.name]}"
         episodes = [run_episode(env, policy, s) for s in seeds]
         ft = np.array([e["ft"] for e in episodes])
         by_type = np.array([e["by_type"] for e in episodes], dtype=float)
         done = [e["steps"] for e in episodes if e["finished"]]
         rows.append({
-            "policy": policy.name, "sensors": len(policy.morphology), "episodes": len(seeds),
+            "policy": name, "sensors": len(policy.morphology), "episodes": len(seeds),
             "ft_mean": float(ft.mean()), "ft_std": float(ft.std()),
             "small": float(by_type[:, 0].mean()), "medium": float(by_type[:, 1].mean()),
             "large": float(by_type[:, 2].mean()),

@@ -54,6 +54,13 @@ def test_compare_two_policies_writes_table_and_figure(tmp_path, capsys):
     assert "| random |" in table and "| heuristic |" in table
 
 
+def test_compare_keeps_policies_of_the_same_name_apart(tmp_path, capsys):
+    assert compare_main(["--policy", "random", "--policy", "random", "--environment", "1", "--steps", "20",
+                         "--robots", "3", "--episodes", "1", "--out", str(tmp_path)]) == 0
+    names = [line.split(",")[0] for line in (tmp_path / "compare.csv").read_text().splitlines()[1:]]
+    assert names == ["random", "random#2"]
+
+
 def test_policy_of_wrong_observation_size_is_refused(tmp_path, capsys):
     env = parallel_env(environment=1, num_robots=3, max_cycles=20, morphology=[{"type": "bottom"}])
     env.reset(seed=0)
