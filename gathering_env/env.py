@@ -36,14 +36,21 @@ value``. An episode's rewards therefore sum to the value part of the task perfor
 
 ## Arguments
 ``parallel_env(environment=2, num_robots=20, max_cycles=10_000, render_mode=None,
-morphology=None, **world_parameters)``: ``environment`` picks the paper's block counts
-(1: 10/5/0, 2: 5/5/5, 3: 0/5/10); any field of ``WorldConfig`` can be overridden by
+render_options=None, morphology=None, **world_parameters)``: ``environment`` picks the paper's
+block counts (1: 10/5/0, 2: 5/5/5, 3: 0/5/10); any field of ``WorldConfig`` can be overridden by
 keyword. ``reset(seed=..., options={"morphology": Morphology | list of sensor dicts})``.
+
+## Rendering
+``render_mode="rgb_array"`` (frames as arrays) or ``"human"`` (a pygame window with keys).
+``render_options={"cones": ..., "view": ..., "size_px": ..., "trail": ..., "panel": ...,
+"min_robot_px": ...}`` choose what frames show (``gathering_env.render``, ``docs/rendering.md``);
+``render(**options)`` overrides them for one frame.
 """
 
 from __future__ import annotations
 
 import warnings
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
@@ -53,6 +60,7 @@ from pettingzoo.utils import wrappers
 from pettingzoo.utils.conversions import parallel_to_aec_wrapper
 
 from .config import WorldConfig
+from .render import RenderOptions
 from .sensors import Morphology
 from .simulation import GatheringSimulation, check_wheels
 
@@ -70,13 +78,17 @@ class GatheringEnv(ParallelEnv):
     }
 
     def __init__(self, environment: int | None = 2, render_mode: str | None = None,
-                 morphology: Morphology | list | dict | None = None, **world_parameters: Any) -> None:
+                 morphology: Morphology | list | dict | None = None,
+                 render_options: dict[str, Any] | None = None, **world_parameters: Any) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode={render_mode!r}; allowed: None, {self.metadata['render_modes']}"
             )
         self.config = WorldConfig.from_kwargs(environment=environment, **world_parameters)
         self.render_mode = render_mode
+        if render_options is not None and not isinstance(render_options, dict):
+            raise TypeError(f"render_options={render_options!r}; allowed: None or a dict of render options")
+        self.render_options = RenderOptions.checked(self.config.num_robots, **(render_options or {}))
         self.morphology = Morphology.khepera_iii() if morphology is None else Morphology.coerce(morphology)
         self.sim = GatheringSimulation(self.config, self.morphology)
         n = self.config.num_robots
@@ -123,6 +135,8 @@ class GatheringEnv(ParallelEnv):
             self._np_random = np.random.default_rng(seed)
         obs = self.sim.reset(self._np_random, self.morphology)
         self.agents = list(self.possible_agents)
+        if self.render_mode is not None:
+            self._get_renderer().record(self.sim)
         if self.render_mode == "human":
             self.render()
         observations = dict(zip(self.agents, obs))
@@ -159,6 +173,8 @@ class GatheringEnv(ParallelEnv):
         infos = {a: dict(info) for a in agents}
         if terminated or truncated:
             self.agents = []
+        if self._renderer is not None:
+            self._renderer.record(self.sim)
         if self.render_mode == "human":
             self.render()
         return observations, rewards, terminations, truncations, infos
@@ -181,6 +197,8 @@ class GatheringEnv(ParallelEnv):
         obs, reward, terminated, truncated = self.sim.step(check_wheels(wheels, len(self.possible_agents)))
         if terminated or truncated:
             self.agents = []
+        if self._renderer is not None:
+            self._renderer.record(self.sim)
         return obs, reward, terminated, truncated
 
     def team_info(self) -> dict[str, Any]:
@@ -223,18 +241,25 @@ class GatheringEnv(ParallelEnv):
         raise ValueError("actions could not be stacked into a (num_robots, 2) array")
 
     # ------------------------------------------------------------------ rendering
-    def render(self):
-        """'rgb_array': (H, W, 3) uint8 frame; 'human': draw into a pygame window."""
+    def render(self, **options: Any):
+        """'rgb_array': (H, W, 3) uint8 frame; 'human': draw into a pygame window.
+
+        ``options`` (render options, see ``render_options``) apply to this frame only.
+        """
         if self.render_mode is None:
             import gymnasium
 
             gymnasium.logger.warn("render() called without a render_mode; pass render_mode='rgb_array' or 'human'")
             return None
+        return self._get_renderer().render(self.sim, **options)
+
+    def _get_renderer(self):
         if self._renderer is None:
             from .render import Renderer
 
-            self._renderer = Renderer(self.config, self.render_mode, fps=self.metadata["render_fps"])
-        return self._renderer.render(self.sim)
+            self._renderer = Renderer(self.config, self.render_mode, fps=self.metadata["render_fps"],
+                                      **asdict(self.render_options))
+        return self._renderer
 
     def close(self) -> None:
         if self._renderer is not None:

@@ -1,32 +1,42 @@
-"""Drawing the collective gathering world with pygame, and saving episodes as GIF/MP4.
+"""Drawing the collective gathering world with pygame; GIF/MP4, film strips, sensor layouts.
 
-The picture follows the paper's Figure 3, seen from above:
+The picture follows the paper's Figure 3, seen from above (``docs/rendering.md`` shows every
+option with a picture):
 
-* the arena floor (``config.arena_width`` x ``config.arena_height`` units) inside a dark wall
-  band, and the gathering zone (``config.zone_rect``) along the south wall in green;
-* blocks as rotated squares coloured by size (small blue, medium amber, large red); gathered
-  blocks (``sim.gathered``) are drawn darker with a white outline;
-* robots as dark discs with a heading stub; robots welded to a block
-  (``world.robot_attached >= 0``) are magenta;
-* every robot's sensor cones (circular sectors of radius ``range`` and full angle ``fov`` from
-  the sensor's mount point on the rim, as in ``sensing.py``) drawn semi-transparently,
-  coloured by sensor type. Overlapping cones of one type do not darken each other; cones of
-  different types blend. Cones are clipped at the walls. Bottom sensors (no cone) are not drawn;
-* a header with the step count, the gathered value / total value and a legend, when
-  ``pygame.font`` works (otherwise the header is left out).
+* the arena floor inside a dark wall band, and the gathering zone (``config.zone_rect``) in green;
+* blocks as rotated squares coloured by size (small blue, medium amber, large red), never
+  smaller than ``MIN_BLOCK_PX``; gathered blocks (``sim.gathered``) are darker with a white
+  outline; blocks a robot is welded to (carried) have a magenta outline;
+* robots as dark discs of at least ``min_robot_px`` pixels radius with a heading mark (a white
+  line inside, a stub outside);
+  robots welded to a block (``world.robot_attached >= 0``) are magenta; robots whose cones are
+  shown while others' are not get an orange ring;
+* sensor cones (circular sectors of radius ``range`` and full angle ``fov`` from the sensor's
+  mount point on the rim, as in ``sensing.py``): all cones are drawn into ONE transparent layer
+  (a light fill plus an outline per cone) that is composited once, so overlapping cones never
+  darken each other however many there are. Cones are clipped at the walls;
+* optional trails: every robot's path over the last ``trail`` recorded steps;
+* an information panel to the right: step, gathered value and blocks by type, a sparkline of
+  the gathered value, the morphology as a table and a legend (text needs ``pygame.font``).
 
-World y points up (north); screen y points down, so y is flipped. The robots are honest-sized
-(0.15 units is ~2.3 px at 640 px for a 40 x 40 arena) but never drawn smaller than 2 px.
+Render options (``Renderer(...)``, ``parallel_env(render_options={...})``,
+``env.render(**options)``, ``gathering-replay --cones/--view/--size/--trail/--no-panel``):
 
-Usage::
+``size_px``      side of the square arena view in pixels (>= 64); the panel adds width.
+``cones``        ``"auto"`` (default), ``"all"``, ``"none"`` or robot indices (``[3]``, ``"0,3"``).
+                 ``"auto"`` is ``"all"`` while the team's summed cone area is at most
+                 ``AUTO_CONES_COVER`` of the arena, otherwise the cones of one robot (the followed
+                 robot in a follow view, else robot 0).
+``view``         ``"full"`` (the arena), ``"zone"`` (a square crop around the zone) or
+                 ``"follow:K"`` (``FOLLOW_SPAN`` units around robot K, which stays centred).
+``trail``        K >= 0: draw each robot's path over its last K steps (0 = no trails).
+``panel``        True: the information panel beside the arena.
+``min_robot_px`` robots are drawn at least this many pixels in radius (>= 1).
 
-    renderer = Renderer(config, "rgb_array", size_px=640)
-    frame = renderer.render(sim)          # (640, 640, 3) uint8, no window, no display needed
-    save_video(frames, "episode.gif")     # or .mp4 with imageio-ffmpeg
-
-pygame is imported lazily by ``Renderer`` so importing ``gathering_env`` does not need it.
-``"rgb_array"`` draws on an offscreen ``pygame.Surface`` and never opens a window; only
-``"human"`` initialises pygame's display.
+World y points up (north); screen y points down. ``Renderer.to_screen`` maps world points to
+frame pixels. pygame is imported lazily by ``Renderer`` so importing ``gathering_env`` does not
+need it; ``"rgb_array"`` draws offscreen and never opens a window. The ``"human"`` window has
+keys (listed in the window): space pause, right arrow step, +/- faster/slower, c cones, esc close.
 """
 
 from __future__ import annotations
@@ -34,13 +44,14 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .config import WorldConfig
-from .sensors import SENSOR_TYPES, TYPE_CODES
+from .config import BLOCK_TYPE_NAMES, WorldConfig
+from .sensors import SENSOR_TYPES, Morphology
 
 if TYPE_CHECKING:  # pragma: no cover
     import pygame
@@ -50,7 +61,7 @@ if TYPE_CHECKING:  # pragma: no cover
 RGB = tuple[int, int, int]
 
 PAGE: RGB = (250, 250, 247)
-"""Background outside the arena and behind the header."""
+"""Background outside the arena and of the panel."""
 FLOOR: RGB = (238, 238, 232)
 """Arena floor."""
 WALL: RGB = (70, 70, 70)
@@ -63,335 +74,909 @@ GATHERED_SHADE = 0.55
 """Gathered blocks are drawn with their colour times this factor, outlined in white."""
 GATHERED_EDGE: RGB = (255, 255, 255)
 ROBOT: RGB = (30, 30, 30)
-"""Robot body (and heading stub)."""
+"""Robot body."""
 ROBOT_ATTACHED: RGB = (230, 0, 170)
-"""Body of a robot welded to a block."""
+"""Body of a robot welded to a block, and the outline of a carried block."""
+HEADING: RGB = (255, 255, 255)
+"""Heading mark: a line from near the robot's centre to its rim."""
+FOCUS: RGB = (255, 120, 0)
+"""Ring around the robots whose cones are shown when not all robots' cones are."""
+TRAIL: RGB = (110, 110, 200)
+"""Colour of the newest trail segment; older segments fade towards the floor colour."""
 TEXT: RGB = (20, 20, 20)
+MUTED: RGB = (110, 110, 110)
 SENSOR_COLOURS: dict[str, RGB] = {
     "infrared": (225, 40, 40),
     "ultrasonic": (40, 90, 225),
     "colour": (160, 50, 200),
-    "camera": (0, 160, 160),
+    "camera": (0, 150, 150),
     "bottom": (120, 120, 120),
 }
-"""Cone colour by sensor type (drawn with alpha ``CONE_ALPHA``)."""
-CONE_ALPHA = 50
-"""Opacity of a sensor cone, 0..255."""
+"""Cone colour by sensor type."""
+CONE_FILL_ALPHA = 24
+"""Opacity (0..255) of a cone's fill; never accumulates (one layer for all cones)."""
+CONE_EDGE_ALPHA = 150
+"""Opacity (0..255) of a cone's outline."""
 
-_TYPE_NAMES = list(SENSOR_TYPES)                 # index = integer type code
-_BOTTOM = TYPE_CODES["bottom"]
+DEFAULT_SIZE_PX = 640
+DEFAULT_MIN_ROBOT_PX = 4
+MIN_BLOCK_PX = 3
+"""Blocks are drawn at least this many pixels from centre to side."""
+AUTO_CONES_COVER = 0.5
+"""``cones="auto"`` shows every robot's cones while their summed area is at most this
+fraction of the arena's area, else one robot's."""
+FOLLOW_SPAN = 10.0
+"""Width (world units) of the square a ``follow:K`` view shows around robot K."""
+ZONE_MARGIN = 3.0
+"""World units shown around the zone in the ``zone`` view."""
+VIEWS = ("full", "zone", "follow:K")
+CONE_CHOICES = ("auto", "all", "none")
+KEYS = "space pause   \u2192 step   +/- speed   c cones   esc close"
+"""The ``"human"`` window's keys, as listed in the window."""
+
+_CONE_ORDER = [t for t in SENSOR_TYPES if t != "bottom"]
 _MAX_ARC_POINTS = 64
 _BLOCK_CORNERS = np.array([[1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0]])
 
 
+class RenderOptionError(ValueError):
+    """A bad render option. ``option``, ``problem`` and ``allowed`` are kept apart for CLIs."""
+
+    def __init__(self, option: str, problem: str, allowed: str) -> None:
+        self.option, self.problem, self.allowed = option, problem, allowed
+        super().__init__(f"{option}: {problem}; allowed: {allowed}")
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+
+def parse_cones(value: Any, num_robots: int) -> str | tuple[int, ...]:
+    """``"auto" | "all" | "none"`` or robot indices (a list, or a string like ``"0,3"``)."""
+    allowed = f"'auto', 'all', 'none' or robot indices in 0..{num_robots - 1} (e.g. [3] or '0,3')"
+    if isinstance(value, str):
+        text = value.strip()
+        if text in CONE_CHOICES:
+            return text
+        try:
+            value = [int(part) for part in text.split(",")]
+        except ValueError:
+            raise RenderOptionError("cones", f"{text!r} is not a choice nor a list of robot indices",
+                                    allowed) from None
+    if not isinstance(value, (list, tuple, np.ndarray)) or not all(_is_int(i) for i in value):
+        raise RenderOptionError("cones", f"{value!r} is not a choice nor a list of robot indices", allowed)
+    indices = tuple(sorted({int(i) for i in value}))
+    bad = [i for i in indices if not 0 <= i < num_robots]
+    if bad:
+        raise RenderOptionError("cones", f"robot index {bad[0]} does not exist ({num_robots} robots)", allowed)
+    return indices
+
+
+def parse_view(value: Any, num_robots: int) -> str:
+    """``"full"``, ``"zone"`` or ``"follow:K"`` with K a robot index; returns it normalised."""
+    allowed = f"'full', 'zone' or 'follow:K' with K in 0..{num_robots - 1}"
+    if isinstance(value, str):
+        text = value.strip()
+        if text in ("full", "zone"):
+            return text
+        if text.startswith("follow:"):
+            try:
+                k = int(text[len("follow:"):])
+            except ValueError:
+                raise RenderOptionError("view", f"{text!r} does not name a robot index", allowed) from None
+            if not 0 <= k < num_robots:
+                raise RenderOptionError("view", f"robot {k} does not exist ({num_robots} robots)", allowed)
+            return f"follow:{k}"
+    raise RenderOptionError("view", f"{value!r} is not a view", allowed)
+
+
+@dataclass(frozen=True)
+class RenderOptions:
+    """What a frame shows (see the module docstring). Build with ``RenderOptions.checked``."""
+
+    size_px: int = DEFAULT_SIZE_PX
+    cones: str | tuple[int, ...] = "auto"
+    view: str = "full"
+    trail: int = 0
+    panel: bool = True
+    min_robot_px: int = DEFAULT_MIN_ROBOT_PX
+
+    @classmethod
+    def checked(cls, num_robots: int, base: RenderOptions | None = None, **options: Any) -> RenderOptions:
+        """``base`` (default: the defaults) with ``options`` replaced, each validated.
+
+        Raises:
+            RenderOptionError (a ValueError) naming the option and the allowed values.
+        """
+        names = [f.name for f in cls.__dataclass_fields__.values()]
+        unknown = sorted(set(options) - set(names))
+        if unknown:
+            raise RenderOptionError(unknown[0], "unknown render option", ", ".join(names))
+        values: dict[str, Any] = {}
+        for name, value in options.items():
+            if name == "size_px":
+                if not _is_int(value) or value < 64:
+                    raise RenderOptionError("size_px", f"{value!r} is not an integer >= 64", "an integer >= 64")
+                value = int(value)
+            elif name == "cones":
+                value = parse_cones(value, num_robots)
+            elif name == "view":
+                value = parse_view(value, num_robots)
+            elif name == "trail":
+                if not _is_int(value) or value < 0:
+                    raise RenderOptionError("trail", f"{value!r} is not an integer >= 0",
+                                            "an integer >= 0 (steps; 0 = no trails)")
+                value = int(value)
+            elif name == "panel":
+                if not isinstance(value, (bool, np.bool_)):
+                    raise RenderOptionError("panel", f"{value!r} is not a bool", "True or False")
+                value = bool(value)
+            elif name == "min_robot_px":
+                if not _is_int(value) or value < 1:
+                    raise RenderOptionError("min_robot_px", f"{value!r} is not an integer >= 1", "an integer >= 1")
+                value = int(value)
+            values[name] = value
+        return replace(base if base is not None else cls(), **values)
+
+    @property
+    def follow(self) -> int | None:
+        """The followed robot of a ``follow:K`` view, else None."""
+        return int(self.view.split(":")[1]) if self.view.startswith("follow:") else None
+
+
 def cone_colour_on(background: RGB, sensor_type: str) -> RGB:
-    """The colour a single cone of ``sensor_type`` gives on a ``background`` pixel (alpha blend)."""
-    a = CONE_ALPHA / 255.0
+    """The colour a cone's fill of ``sensor_type`` gives on a ``background`` pixel (alpha blend)."""
+    a = CONE_FILL_ALPHA / 255.0
     c = SENSOR_COLOURS[sensor_type]
     return tuple(int(round(b * (1.0 - a) + v * a)) for b, v in zip(background, c))  # type: ignore[return-value]
 
 
+def cone_sensors(morphology: Morphology) -> list[tuple[str, float, float, float, float]]:
+    """(type, bearing, axis offset from the heading, range, fov) of every sensor with a cone."""
+    return [(s.type, s.bearing, s.bearing + s.orientation, float(s.range), float(s.fov))
+            for s in morphology if s.type != "bottom" and (s.range or 0) > 0 and (s.fov or 0) > 0]
+
+
+def team_cone_cover(morphology: Morphology, config: WorldConfig) -> float:
+    """Summed area of every robot's cones over the arena's area (overlaps counted twice)."""
+    area = sum(0.5 * rng * rng * fov for _, _, _, rng, fov in cone_sensors(morphology))
+    return config.num_robots * area / (config.arena_width * config.arena_height)
+
+
+def _degrees(angle: float) -> str:
+    return f"{math.degrees(angle):+.0f}\u00b0"
+
+
+def morphology_rows(morphology: Morphology) -> list[tuple[str, str, str, str, str, str]]:
+    """The morphology table: (#, type, bearing, orientation, range, FOV) per sensor, as text."""
+    rows = []
+    for i, s in enumerate(morphology):
+        if s.type == "bottom":
+            rows.append((str(i), s.type, _degrees(s.bearing), "\u2013", "\u2013", "\u2013"))
+        else:
+            rows.append((str(i), s.type, _degrees(s.bearing), _degrees(s.orientation),
+                         f"{s.range:.1f}", f"{math.degrees(s.fov):.0f}\u00b0"))
+    return rows
+
+
+_TABLE_HEADER = ("#", "type", "bearing", "orient.", "range", "FOV")
+_TABLE_WIDEST = ("10", "ultrasonic", "+180\u00b0", "+90\u00b0", "25.0", "180\u00b0")
+
+
+class _Text:
+    """pygame text helpers with one font; every call is a no-op without a font."""
+
+    def __init__(self, pg: Any, size: int) -> None:
+        self.pg = pg
+        try:
+            if not pg.font.get_init():
+                pg.font.init()
+            self.font = pg.font.Font(None, size)
+        except Exception:  # noqa: BLE001 - fonts are optional: no font, no text
+            self.font = None
+
+    @property
+    def line(self) -> int:
+        return self.font.get_linesize() if self.font is not None else 0
+
+    def width(self, text: str) -> int:
+        return self.font.size(text)[0] if self.font is not None else 0
+
+    def draw(self, surf: pygame.Surface, text: str, x: int, y: int, colour: RGB = TEXT,
+             right: bool = False) -> int:
+        """Blit ``text`` with its top-left (top-right if ``right``) at (x, y); returns its width."""
+        if self.font is None:
+            return 0
+        label = self.font.render(text, True, colour)
+        surf.blit(label, (x - label.get_width() if right else x, y))
+        return label.get_width()
+
+    def table_columns(self, gap: int) -> tuple[list[int], list[int], int]:
+        """Left edges and widths of the morphology table's columns, and the table's width."""
+        widths = [max(self.width(a), self.width(b)) for a, b in zip(_TABLE_HEADER, _TABLE_WIDEST)]
+        lefts = [sum(widths[:i]) + i * gap for i in range(len(widths))]
+        return lefts, widths, lefts[-1] + widths[-1]
+
+    def draw_table(self, surf: pygame.Surface, morphology: Morphology, x: int, y: int, gap: int) -> int:
+        """Draw the morphology table with a colour swatch per type; returns the height used."""
+        if self.font is None:
+            return 0
+        cols, widths, _ = self.table_columns(gap)
+        sw = max(4, self.line // 2)
+        rows = [_TABLE_HEADER] + morphology_rows(morphology)
+        for r, row in enumerate(rows):
+            yy = y + r * self.line
+            for c, cell in enumerate(row):
+                colour = MUTED if r == 0 else TEXT
+                if c == 0:
+                    self.draw(surf, cell, x + cols[0] + widths[0], yy, colour, right=True)
+                elif c == 1:
+                    if r > 0:
+                        box = self.pg.Rect(x + cols[1], yy + (self.line - sw) // 2, sw, sw)
+                        self.pg.draw.rect(surf, SENSOR_COLOURS[cell], box)
+                    self.draw(surf, cell, x + cols[1] + (sw + 3 if r > 0 else 0), yy, colour)
+                else:
+                    self.draw(surf, cell, x + cols[c] + widths[c], yy, colour, right=True)
+        return len(rows) * self.line
+
+
+def _cone_polygons(pos: np.ndarray, angle: np.ndarray, robot_radius: float, bearing: float,
+                   offset: float, rng: float, fov: float, k: int) -> np.ndarray:
+    """World polygons (N, k + 1, 2) of one sensor's cone on robots at ``pos``/``angle``."""
+    offsets = np.linspace(-0.5 * fov, 0.5 * fov, k)
+    mount = angle + bearing
+    pts = np.empty((len(pos), k + 1, 2))
+    pts[:, 0, 0] = pos[:, 0] + robot_radius * np.cos(mount)
+    pts[:, 0, 1] = pos[:, 1] + robot_radius * np.sin(mount)
+    arc = (angle + offset)[:, None] + offsets[None, :]
+    pts[:, 1:, 0] = pts[:, :1, 0] + rng * np.cos(arc)
+    pts[:, 1:, 1] = pts[:, :1, 1] + rng * np.sin(arc)
+    return pts
+
+
+def _arc_points(radius_px: float, fov: float) -> int:
+    """Points along a cone's arc so the chord error stays under half a pixel."""
+    radius_px = max(radius_px, 1.0)
+    step = 2.0 * math.acos(max(-1.0, 1.0 - 0.5 / radius_px))
+    return int(min(_MAX_ARC_POINTS, max(2, math.ceil(fov / step) + 1)))
+
+
+def _draw_cone_layer(pg: Any, layer: pygame.Surface, target: pygame.Surface,
+                     polygons: list[tuple[str, list]]) -> None:
+    """Fill then outline every (type, screen polygon) in ``layer``, then composite it once."""
+    clip = layer.get_clip()
+    layer.set_clip(None)
+    layer.fill((0, 0, 0, 0))
+    layer.set_clip(clip)
+    for kind, poly in polygons:
+        pg.draw.polygon(layer, SENSOR_COLOURS[kind] + (CONE_FILL_ALPHA,), poly)
+    for kind, poly in polygons:
+        pg.draw.polygon(layer, SENSOR_COLOURS[kind] + (CONE_EDGE_ALPHA,), poly, 1)
+    target.blit(layer, (0, 0))
+
+
+def _surface_to_array(pg: Any, surf: pygame.Surface) -> np.ndarray:
+    view = pg.surfarray.pixels3d(surf)             # (W, H, 3) view, locks the surface
+    try:
+        return np.ascontiguousarray(view.transpose(1, 0, 2))
+    finally:
+        del view
+
+
 class Renderer:
-    """Draws a ``GatheringSimulation`` as a square picture.
+    """Draws a ``GatheringSimulation``: a square arena view plus the information panel.
 
     Args:
-        config: the world's config (arena size, zone, robot radius).
+        config: the world's config (arena size, zone, robot radius, team size).
         render_mode: ``"rgb_array"`` (``render`` returns frames; offscreen, never opens a
             window) or ``"human"`` (``render`` shows the frame in a pygame window).
-        size_px: width = height of the picture in pixels (>= 64). The arena is scaled
-            uniformly to fit (non-square arenas are centred).
+        size_px: side of the square arena view in pixels (>= 64).
         fps: frame rate the ``"human"`` window is throttled to (frames per second).
+        **options: the other render options (``cones``, ``view``, ``trail``, ``panel``,
+            ``min_robot_px``; see the module docstring).
+
+    A frame is ``(size_px, size_px + panel_px, 3)``: the arena view on the left, the panel (if
+    any) on the right.
 
     Attributes:
-        scale: pixels per world unit.
-        arena_rect: (left, top, width, height) of the arena floor in pixels.
+        scale: pixels per world unit (of the last frame drawn, for the follow view).
+        arena_rect: (left, top, width, height) of the arena floor in pixels (idem).
+        panel_px: width of the panel in pixels (0 without it).
     """
 
-    def __init__(self, config: WorldConfig, render_mode: str, size_px: int = 640, fps: int = 30) -> None:
+    def __init__(self, config: WorldConfig, render_mode: str, size_px: int = DEFAULT_SIZE_PX,
+                 fps: float = 30, **options: Any) -> None:
         if render_mode not in ("rgb_array", "human"):
             raise ValueError(f"render_mode={render_mode!r}; allowed: 'rgb_array', 'human'")
-        if isinstance(size_px, bool) or not isinstance(size_px, (int, np.integer)) or size_px < 64:
-            raise ValueError(f"size_px={size_px!r}; allowed: an integer >= 64")
         if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) or not fps > 0:
             raise ValueError(f"fps={fps!r}; allowed: a number > 0")
+        opts = RenderOptions.checked(config.num_robots, size_px=size_px, **options)
         os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
         import pygame
 
         self._pg = pygame
         self.config = config
         self.render_mode = render_mode
-        self.size_px = int(size_px)
-        self.fps = fps
+        self.fps = float(fps)
         self._window: pygame.Surface | None = None
         self._clock: pygame.time.Clock | None = None
-        self._font = self._load_font()
-        self._legend_cache: dict[tuple[int, ...], pygame.Surface] = {}
+        self.paused = False
+        self._cone_toggle = 0            # "human" key c: 0 = options.cones, 1 = "all", 2 = "none"
+        # History of the episode, recorded by ``record`` (every step when driven by the env).
+        self._last_step = -1
+        self._value_steps: list[int] = []
+        self._values: list[float] = []
+        self._positions: list[np.ndarray] = []
+        self._configure(opts)
 
-        # Layout: header (text) on top, then the arena inside its wall band, centred.
-        size = self.size_px
+    # ------------------------------------------------------------------ options and layout
+    @property
+    def options(self) -> RenderOptions:
+        return self._options
+
+    @property
+    def size_px(self) -> int:
+        return self._options.size_px
+
+    def set_options(self, **options: Any) -> None:
+        """Change render options from now on (validated like the constructor's)."""
+        self._configure(RenderOptions.checked(self.config.num_robots, self._options, **options))
+
+    def _configure(self, opts: RenderOptions) -> None:
+        pg = self._pg
+        self._options = opts
+        size = opts.size_px
+        self._text = _Text(pg, max(13, size // 32))
+        self._small = _Text(pg, max(12, size // 40))
         self.wall_px = max(2, int(round(size / 100)))
-        pad = self.wall_px + 2
-        if self._font is not None and size >= 200:
-            self.header_px = 2 * self._font.get_linesize() + 6
+        if opts.panel:
+            gap = max(6, self._text.width("00"))
+            table_w = self._text.table_columns(gap)[2] if self._text.font is not None else 0
+            self.panel_px = max(size // 3, table_w + 2 * self._margin)
         else:
-            self.header_px = 0
-        avail_w = size - 2 * pad
-        avail_h = size - self.header_px - 2 * pad
-        self.scale = min(avail_w / config.arena_width, avail_h / config.arena_height)
-        self._ox = 0.5 * (size - config.arena_width * self.scale)
-        self._oy = self.header_px + pad + 0.5 * (avail_h - config.arena_height * self.scale)
-        left, top = int(round(self._ox)), int(round(self._oy))
-        self.arena_rect = (left, top,
-                           int(round(self._ox + config.arena_width * self.scale)) - left,
-                           int(round(self._oy + config.arena_height * self.scale)) - top)
-        self.robot_px = max(2, int(round(config.robot_radius * self.scale)))
+            self.panel_px = 0
+        shape = (size + self.panel_px, size)
+        if getattr(self, "_surface", None) is None or self._surface.get_size() != shape:
+            self._surface = pg.Surface(shape)
+            self._layer = pg.Surface((size, size), pg.SRCALPHA)
+        self._set_view(0.5 * self.config.arena_width, 0.5 * self.config.arena_height, None)
 
-        self._surface = pygame.Surface((size, size))
-        self._background = self._draw_background()
-        # One transparent layer per cone type, created when first needed.
-        self._layers: dict[int, pygame.Surface] = {}
+    @property
+    def _margin(self) -> int:
+        return max(6, self._options.size_px // 64)
+
+    def _set_view(self, cx: float, cy: float, span: float | None) -> None:
+        """Map world point (cx, cy) to the view's centre; ``span`` units across (None: arena)."""
+        cfg, size = self.config, self._options.size_px
+        if span is None:
+            avail = size - 2 * (self.wall_px + 2)
+            self.scale = min(avail / cfg.arena_width, avail / cfg.arena_height)
+        else:
+            self.scale = size / span
+        self._ox = 0.5 * size - cx * self.scale
+        self._oy = 0.5 * size + cy * self.scale
+        (left, top), (right, bottom) = self.to_screen(np.array([[0.0, cfg.arena_height], [cfg.arena_width, 0.0]]))
+        left, top = int(round(left)), int(round(top))
+        self.arena_rect = (left, top, int(round(right)) - left, int(round(bottom)) - top)
+
+    def _view_for(self, sim: GatheringSimulation) -> None:
+        cfg, opts = self.config, self._options
+        follow = opts.follow
+        if follow is not None:
+            x, y = sim.world.robot_pos[follow]
+            self._set_view(float(x), float(y), FOLLOW_SPAN)
+        elif opts.view == "zone":
+            x0, y0, x1, y1 = cfg.zone_rect
+            span = max(x1 - x0, y1 - y0) + 2 * ZONE_MARGIN
+            edge = 0.5                                           # show a little of the wall
+            centre = []
+            for c, extent in ((0.5 * (x0 + x1), cfg.arena_width), (0.5 * (y0 + y1), cfg.arena_height)):
+                lo, hi = 0.5 * span - edge, extent + edge - 0.5 * span
+                centre.append(0.5 * extent if lo > hi else min(max(c, lo), hi))
+            self._set_view(centre[0], centre[1], span)
+        else:
+            self._set_view(0.5 * cfg.arena_width, 0.5 * cfg.arena_height, None)
 
     # ------------------------------------------------------------------ geometry
     def to_screen(self, xy: np.ndarray) -> np.ndarray:
-        """World coordinates (..., 2) in units -> screen pixels (..., 2) as floats, y flipped.
+        """World coordinates (..., 2) in units -> frame pixels (..., 2) as floats, y flipped.
 
         The pixel containing a world point is ``to_screen(p).astype(int)`` -> (column, row).
         """
         xy = np.asarray(xy, dtype=float)
         out = np.empty(xy.shape, dtype=float)
         out[..., 0] = self._ox + xy[..., 0] * self.scale
-        out[..., 1] = self._oy + (self.config.arena_height - xy[..., 1]) * self.scale
+        out[..., 1] = self._oy - xy[..., 1] * self.scale
         return out
 
-    def _arc_points(self, range_units: float, fov: float) -> int:
-        """Points along a cone's arc so the chord error stays under half a pixel."""
-        radius_px = max(range_units * self.scale, 1.0)
-        step = 2.0 * math.acos(max(-1.0, 1.0 - 0.5 / radius_px))
-        return int(min(_MAX_ARC_POINTS, max(2, math.ceil(fov / step) + 1)))
+    @property
+    def robot_px(self) -> int:
+        """Drawn robot radius in pixels: true size, at least ``min_robot_px``."""
+        return max(self._options.min_robot_px, int(round(self.config.robot_radius * self.scale)))
+
+    def cone_robots(self, sim: GatheringSimulation) -> np.ndarray:
+        """Indices of the robots whose cones are drawn (after the ``"human"`` key c)."""
+        n = len(sim.world.robot_pos)
+        cones = (self._options.cones, "all", "none")[self._cone_toggle]
+        if cones == "none":
+            return np.arange(0)
+        if cones == "all":
+            return np.arange(n)
+        if cones == "auto":
+            if team_cone_cover(sim.morphology, self.config) <= AUTO_CONES_COVER:
+                return np.arange(n)
+            return np.array([self._options.follow or 0])
+        return np.array(cones, dtype=int)
+
+    # ------------------------------------------------------------------ history
+    def record(self, sim: GatheringSimulation) -> None:
+        """Note the current step (gathered value, robot positions) for the sparkline and trails.
+
+        The env calls this after every reset and step; ``render`` calls it too. A step count
+        lower than the last one (or 0) starts a new history.
+        """
+        steps = int(sim.steps)
+        if steps == self._last_step and steps != 0:
+            return
+        if steps == 0 or steps < self._last_step:
+            self._value_steps, self._values, self._positions = [], [], []
+        self._last_step = steps
+        self._value_steps.append(steps)
+        self._values.append(float(sim.gathered_value))
+        keep = self._options.trail
+        if keep > 0:
+            self._positions.append(np.array(sim.world.robot_pos, dtype=float))
+            del self._positions[:-(keep + 1)]
 
     # ------------------------------------------------------------------ drawing
-    def _load_font(self):
-        """pygame's default font, or None if ``pygame.font`` is unavailable."""
-        pg = self._pg
-        try:
-            if not pg.font.get_init():
-                pg.font.init()
-            return pg.font.Font(None, max(14, self.size_px // 36))
-        except Exception:  # noqa: BLE001 - fonts are optional: no font, no text
-            return None
-
-    def _draw_background(self) -> pygame.Surface:
-        """The static part of every frame: page, wall band, floor and zone."""
-        pg, cfg = self._pg, self.config
-        bg = pg.Surface((self.size_px, self.size_px))
-        bg.fill(PAGE)
-        left, top, width, height = self.arena_rect
-        wp = self.wall_px
-        pg.draw.rect(bg, WALL, pg.Rect(left - wp, top - wp, width + 2 * wp, height + 2 * wp))
-        pg.draw.rect(bg, FLOOR, pg.Rect(self.arena_rect))
-        x0, y0, x1, y1 = cfg.zone_rect
-        (sx0, sy1), (sx1, sy0) = self.to_screen(np.array([[x0, y1], [x1, y0]]))
-        zl, zt = int(round(sx0)), int(round(sy1))
-        zone = pg.Rect(zl, zt, int(round(sx1)) - zl, int(round(sy0)) - zt)
-        pg.draw.rect(bg, ZONE, zone)
-        pg.draw.rect(bg, ZONE_EDGE, zone, 1)
-        return bg
-
     def draw(self, sim: GatheringSimulation) -> pygame.Surface:
         """Draw the current state of ``sim`` onto the internal surface and return it.
 
         The surface is reused by the next call; copy it if you keep it.
         """
-        if not hasattr(sim, "gathered") or getattr(sim.world, "space", None) is None:
+        if not hasattr(sim, "gathered") or getattr(sim.world, "robot_pos", None) is None:
             raise RuntimeError("render() called before the simulation was reset; call reset() first")
-        surf = self._surface
-        surf.blit(self._background, (0, 0))
+        self.record(sim)
+        pg, surf = self._pg, self._surface
+        size = self._options.size_px
+        self._view_for(sim)
+        surf.fill(PAGE)
+        surf.set_clip(pg.Rect(0, 0, size, size))
+        self._draw_arena(surf)
+        self._draw_trails(surf)
         self._draw_cones(sim, surf)
         self._draw_blocks(sim, surf)
         self._draw_robots(sim, surf)
-        self._draw_header(sim, surf)
+        if self.render_mode == "human" and self._window is not None and not self.panel_px:
+            self._draw_keys(surf, 4, size - self._small.line - 4)
+        surf.set_clip(None)
+        if self.panel_px:
+            self._draw_panel(sim, surf)
         return surf
+
+    def _draw_arena(self, surf: pygame.Surface) -> None:
+        """Wall band, floor and zone."""
+        pg, cfg = self._pg, self.config
+        left, top, width, height = self.arena_rect
+        wp = self.wall_px
+        pg.draw.rect(surf, WALL, pg.Rect(left - wp, top - wp, width + 2 * wp, height + 2 * wp))
+        pg.draw.rect(surf, FLOOR, pg.Rect(self.arena_rect))
+        x0, y0, x1, y1 = cfg.zone_rect
+        (sx0, sy1), (sx1, sy0) = self.to_screen(np.array([[x0, y1], [x1, y0]]))
+        zl, zt = int(round(sx0)), int(round(sy1))
+        zone = pg.Rect(zl, zt, int(round(sx1)) - zl, int(round(sy0)) - zt)
+        pg.draw.rect(surf, ZONE, zone)
+        pg.draw.rect(surf, ZONE_EDGE, zone, 1)
+
+    def _draw_trails(self, surf: pygame.Surface) -> None:
+        if self._options.trail <= 0 or len(self._positions) < 2:
+            return
+        pg = self._pg
+        pts = self.to_screen(np.stack(self._positions))               # (T, N, 2), oldest first
+        t = len(pts)
+        width = 2 if self.scale >= 30 else 1
+        for age in range(t - 1):
+            f = (age + 1) / (t - 1)                                   # 1 for the newest segment
+            colour = tuple(int(round(a + (b - a) * f)) for a, b in zip(FLOOR, TRAIL))
+            for a, b in zip(pts[age].tolist(), pts[age + 1].tolist()):
+                pg.draw.line(surf, colour, a, b, width)
+
+    def _draw_cones(self, sim: GatheringSimulation, surf: pygame.Surface) -> None:
+        pg, w = self._pg, sim.world
+        robots = self.cone_robots(sim)
+        sensors = cone_sensors(sim.morphology)
+        if not sensors or robots.size == 0:
+            return
+        pos, angle = w.robot_pos[robots], w.robot_angle[robots]
+        polygons: list[tuple[str, list]] = []
+        for kind, bearing, offset, rng, fov in sensors:
+            k = _arc_points(rng * self.scale, fov)
+            pts = _cone_polygons(pos, angle, self.config.robot_radius, bearing, offset, rng, fov, k)
+            polygons.extend((kind, poly) for poly in self.to_screen(pts).tolist())
+        size = self._options.size_px
+        clip = pg.Rect(self.arena_rect).clip(pg.Rect(0, 0, size, size))
+        self._layer.set_clip(clip)
+        _draw_cone_layer(pg, self._layer, surf, polygons)
 
     def _draw_blocks(self, sim: GatheringSimulation, surf: pygame.Surface) -> None:
         pg, w = self._pg, sim.world
-        n = len(w.block_half)
+        n = len(w.block_pos)
         if n == 0:
             return
+        half = np.asarray(w.block_half, dtype=float)
+        half = np.maximum(half, MIN_BLOCK_PX / self.scale)
         c, s = np.cos(w.block_angle), np.sin(w.block_angle)
-        local = _BLOCK_CORNERS[None, :, :] * w.block_half[:, None, None]            # (B, 4, 2)
+        local = _BLOCK_CORNERS[None, :, :] * half[:, None, None]               # (B, 4, 2)
         world_pts = np.empty_like(local)
         world_pts[..., 0] = w.block_pos[:, None, 0] + c[:, None] * local[..., 0] - s[:, None] * local[..., 1]
         world_pts[..., 1] = w.block_pos[:, None, 1] + s[:, None] * local[..., 0] + c[:, None] * local[..., 1]
         corners = self.to_screen(world_pts).tolist()
-        gathered = np.asarray(sim.gathered, dtype=bool)
-        types = w.block_type.tolist()
+        gathered = np.asarray(sim.gathered, dtype=bool).tolist()
+        attached = np.asarray(w.robot_attached)
+        carried = set(attached[attached >= 0].tolist())
+        types = np.asarray(w.block_type).tolist()
+        edge_w = 2 if self.scale * 0.6 >= 12 else 1
         for j in range(n):
             colour = BLOCK_COLOURS[types[j]]
             if gathered[j]:
                 colour = tuple(int(v * GATHERED_SHADE) for v in colour)
-                pg.draw.polygon(surf, colour, corners[j])
-                pg.draw.polygon(surf, GATHERED_EDGE, corners[j], 1)
-            else:
-                pg.draw.polygon(surf, colour, corners[j])
+            pg.draw.polygon(surf, colour, corners[j])
+            if gathered[j]:
+                pg.draw.polygon(surf, GATHERED_EDGE, corners[j], edge_w)
+            elif j in carried:
+                pg.draw.polygon(surf, ROBOT_ATTACHED, corners[j], edge_w)
 
     def _draw_robots(self, sim: GatheringSimulation, surf: pygame.Surface) -> None:
         pg, w = self._pg, sim.world
+        n = len(w.robot_pos)
         rad = self.robot_px
-        stub = rad + max(2, rad // 2 + 1)          # heading stub length from the centre (px)
         centres = self.to_screen(w.robot_pos)
-        tips = centres + stub * np.stack([np.cos(w.robot_angle), -np.sin(w.robot_angle)], axis=1)
+        heading = np.stack([np.cos(w.robot_angle), -np.sin(w.robot_angle)], axis=1)
+        starts = (centres + 0.35 * rad * heading).tolist()
+        tips = (centres + (rad - 0.5) * heading).tolist()
+        stubs = (centres + (rad + max(3, rad // 2 + 1)) * heading).tolist()
         centres_i = np.rint(centres).astype(int).tolist()
-        tips_l = tips.tolist()
         attached = (np.asarray(w.robot_attached) >= 0).tolist()
-        width = 1 if rad < 4 else 2
-        for i in range(len(centres_i)):
+        focus = self.cone_robots(sim)
+        focus = focus.tolist() if 0 < focus.size < n else []
+        mark_w = max(1, rad // 4)
+        for i in focus:
+            pg.draw.circle(surf, FOCUS, centres_i[i], rad + max(2, rad // 2), max(1, rad // 4))
+        for i in range(n):
             colour = ROBOT_ATTACHED if attached[i] else ROBOT
-            pg.draw.line(surf, colour, centres_i[i], tips_l[i], width)
+            pg.draw.line(surf, colour, centres_i[i], stubs[i], mark_w + 1)
             pg.draw.circle(surf, colour, centres_i[i], rad)
+            pg.draw.line(surf, HEADING, starts[i], tips[i], mark_w)
 
-    def _cone_sensors(self, sim: GatheringSimulation) -> list[tuple[int, float, float, float, float]]:
-        """(type code, bearing, axis offset, range, fov) of every sensor with a cone."""
-        bank = getattr(sim, "bank", None)
-        if bank is not None:
-            half = np.arctan2(bank.sin_half, bank.cos_half)
-            rows = zip(bank.types.tolist(), bank.bearing.tolist(), bank.axis_offset.tolist(),
-                       bank.range.tolist(), (2.0 * half).tolist())
-        else:
-            rows = ((TYPE_CODES[s.type], s.bearing, s.bearing + s.orientation, s.range, s.fov)
-                    for s in sim.morphology)
-        return [r for r in rows if r[0] != _BOTTOM and r[3] > 0.0 and r[4] > 0.0]
+    # ------------------------------------------------------------------ panel
+    def _draw_panel(self, sim: GatheringSimulation, surf: pygame.Surface) -> None:
+        pg, text, small = self._pg, self._text, self._small
+        size, m = self._options.size_px, self._margin
+        x0 = size + m
+        width = self.panel_px - 2 * m
+        pg.draw.line(surf, (210, 210, 205), (size, 0), (size, size - 1))
+        y = m
+        cfg = self.config
+        text.draw(surf, f"step {sim.steps} / {cfg.max_cycles}", x0, y)
+        y += text.line
+        text.draw(surf, f"gathered value {sim.gathered_value:g} / {sim.total_value:g}", x0, y)
+        y += text.line
+        types = np.asarray(sim.world.block_type)
+        gathered = np.asarray(sim.gathered, dtype=bool)
+        sw = max(6, text.line - 6)
+        for t, name in enumerate(BLOCK_TYPE_NAMES):
+            total = int(np.sum(types == t))
+            if total == 0:
+                continue
+            done = int(np.sum(gathered & (types == t)))
+            pg.draw.rect(surf, BLOCK_COLOURS[t], pg.Rect(x0, y + (text.line - sw) // 2, sw, sw))
+            text.draw(surf, f"{name} {done} / {total}", x0 + sw + 4, y)
+            y += text.line
+        y += m // 2
+        # sparkline of the gathered value over the episode
+        spark_h = max(24, size // 10)
+        small.draw(surf, "gathered value over the episode", x0, y, MUTED)
+        y += small.line + 2
+        self._draw_sparkline(surf, pg.Rect(x0, y, width, spark_h), sim.total_value)
+        y += spark_h + m
+        # morphology table
+        text.draw(surf, f"sensors ({len(sim.morphology)}, every robot)", x0, y)
+        y += text.line
+        y += text.draw_table(surf, sim.morphology, x0, y, max(6, text.width("00"))) + m // 2
+        # legend
+        y = self._draw_legend(surf, sim, x0, y, width) + m // 2
+        small.draw(surf, f"view {self._options.view}, cones {self._cones_label(sim)}"
+                   + (f", trail {self._options.trail}" if self._options.trail else ""), x0, y, MUTED)
+        y += small.line
+        if self.render_mode == "human" and self._window is not None:
+            self._draw_keys(surf, x0, max(y + 2, size - m - 2 * small.line), width)
 
-    def _layer(self, code: int) -> pygame.Surface:
-        layer = self._layers.get(code)
-        if layer is None:
-            pg = self._pg
-            layer = pg.Surface((self.size_px, self.size_px), pg.SRCALPHA)
-            layer.set_clip(pg.Rect(self.arena_rect))
-            self._layers[code] = layer
-        return layer
+    def _cones_label(self, sim: GatheringSimulation) -> str:
+        robots = self.cone_robots(sim)
+        if robots.size == len(sim.world.robot_pos):
+            return "all"
+        if robots.size == 0:
+            return "none"
+        return "robot " + ",".join(str(i) for i in robots.tolist())
 
-    def _draw_cones(self, sim: GatheringSimulation, surf: pygame.Surface) -> None:
-        pg, w = self._pg, sim.world
-        sensors = self._cone_sensors(sim)
-        if not sensors or len(w.robot_pos) == 0:
+    def _draw_sparkline(self, surf: pygame.Surface, box: pygame.Rect, total: float) -> None:
+        pg = self._pg
+        pg.draw.rect(surf, (255, 255, 255), box)
+        pg.draw.rect(surf, (200, 200, 195), box, 1)
+        if not self._values:
             return
-        r = self.config.robot_radius
-        pos, angle = w.robot_pos, w.robot_angle
-        used: list[int] = []
-        for code, bearing, offset, rng, fov in sensors:
-            layer = self._layer(code)
-            if code not in used:
-                layer.fill((0, 0, 0, 0))
-                used.append(code)
-            colour = SENSOR_COLOURS[_TYPE_NAMES[code]] + (CONE_ALPHA,)
-            k = self._arc_points(rng, fov)
-            offsets = np.linspace(-0.5 * fov, 0.5 * fov, k)                      # (K,)
-            mount_angle = angle + bearing                                        # (N,)
-            pts = np.empty((len(pos), k + 1, 2))
-            pts[:, 0, 0] = pos[:, 0] + r * np.cos(mount_angle)
-            pts[:, 0, 1] = pos[:, 1] + r * np.sin(mount_angle)
-            arc = (angle + offset)[:, None] + offsets[None, :]                    # (N, K)
-            pts[:, 1:, 0] = pts[:, :1, 0] + rng * np.cos(arc)
-            pts[:, 1:, 1] = pts[:, :1, 1] + rng * np.sin(arc)
-            for poly in self.to_screen(pts).tolist():
-                pg.draw.polygon(layer, colour, poly)
-        for code in used:
-            surf.blit(self._layers[code], (0, 0))
+        steps = np.asarray(self._value_steps, dtype=float)
+        values = np.asarray(self._values, dtype=float)
+        x_max = max(float(self.config.max_cycles), 1.0)
+        cols = np.arange(box.width - 2)
+        at = cols / max(box.width - 3, 1) * x_max
+        at = at[at <= steps[-1]]
+        idx = np.searchsorted(steps, at, side="right") - 1
+        v = values[np.maximum(idx, 0)] / max(total, 1e-12)
+        xs = box.left + 1 + np.arange(len(at))
+        ys = box.bottom - 2 - v * (box.height - 4)
+        pts = np.stack([xs, ys], axis=1).tolist()
+        if len(pts) >= 2:
+            pg.draw.lines(surf, ZONE_EDGE, False, pts, 2)
+        elif pts:
+            pg.draw.circle(surf, ZONE_EDGE, pts[0], 2)
 
-    def _draw_header(self, sim: GatheringSimulation, surf: pygame.Surface) -> None:
-        font = self._font
-        if font is None or self.header_px == 0:
-            return
-        try:
-            n_blocks = len(sim.gathered)
-            text = (f"step {sim.steps}/{self.config.max_cycles}    gathered value "
-                    f"{sim.gathered_value:g}/{sim.total_value:g}    blocks {int(np.sum(sim.gathered))}/{n_blocks}")
-            surf.blit(font.render(text, True, TEXT), (6, 3))
-            codes = tuple(sorted({s[0] for s in self._cone_sensors(sim)}))
-            legend = self._legend_cache.get(codes)
-            if legend is None:
-                legend = self._legend_cache[codes] = self._make_legend(codes)
-            surf.blit(legend, (6, 3 + font.get_linesize()))
-        except Exception:  # noqa: BLE001 - text is decoration; never fail a frame over it
-            self._font = None
-
-    def _make_legend(self, cone_codes: tuple[int, ...]) -> pygame.Surface:
-        """One line of colour swatches and names: block sizes, gathered, attached, cone types."""
-        pg, font = self._pg, self._font
-        h = font.get_linesize()
-        legend = pg.Surface((self.size_px - 12, h))
-        legend.fill(PAGE)
-        sw = max(6, h - 5)
-        x = 0
-        items: list[tuple[str, RGB, RGB | None, bool]] = [
-            ("small", BLOCK_COLOURS[0], None, False),
-            ("medium", BLOCK_COLOURS[1], None, False),
-            ("large", BLOCK_COLOURS[2], None, False),
-            ("gathered", tuple(int(v * GATHERED_SHADE) for v in BLOCK_COLOURS[1]), GATHERED_EDGE, False),
-            ("robot", ROBOT, None, True),
-            ("attached", ROBOT_ATTACHED, None, True),
+    def _draw_legend(self, surf: pygame.Surface, sim: GatheringSimulation, x0: int, y: int, width: int) -> int:
+        """Swatches with names, wrapped to the panel width; returns the y below them."""
+        pg, small = self._pg, self._small
+        h = max(small.line, 10)
+        sw = max(6, h - 4)
+        kinds = sorted({c[0] for c in cone_sensors(sim.morphology)}, key=_CONE_ORDER.index)
+        items: list[tuple[str, str, RGB, RGB | None]] = [
+            ("gathered", "box", tuple(int(v * GATHERED_SHADE) for v in BLOCK_COLOURS[1]), GATHERED_EDGE),
+            ("carried", "box", BLOCK_COLOURS[1], ROBOT_ATTACHED),
+            ("robot", "disc", ROBOT, None),
+            ("attached", "disc", ROBOT_ATTACHED, None),
         ]
-        for code in cone_codes:
-            name = _TYPE_NAMES[code]
-            items.append((name, cone_colour_on(FLOOR, name), SENSOR_COLOURS[name], False))
-        top = (h - sw) // 2
-        for name, fill, edge, disc in items:
-            if disc:
-                pg.draw.circle(legend, fill, (x + sw // 2, top + sw // 2), max(2, sw // 3))
+        if self._options.trail:
+            items.append(("trail", "line", TRAIL, None))
+        items += [(kind, "box", cone_colour_on(FLOOR, kind), SENSOR_COLOURS[kind]) for kind in kinds]
+        x = x0
+        for name, shape, fill, edge in items:
+            need = sw + 3 + small.width(name) + 10
+            if x > x0 and x + need > x0 + width:
+                x, y = x0, y + h
+            top = y + (h - sw) // 2
+            if shape == "disc":
+                pg.draw.circle(surf, fill, (x + sw // 2, top + sw // 2), sw // 2)
+                pg.draw.line(surf, HEADING, (x + sw // 2 + 1, top + sw // 2), (x + sw - 1, top + sw // 2))
+            elif shape == "line":
+                pg.draw.line(surf, fill, (x, top + sw // 2), (x + sw, top + sw // 2), 2)
             else:
                 box = pg.Rect(x, top, sw, sw)
-                pg.draw.rect(legend, fill, box)
-                if edge is not None:
-                    pg.draw.rect(legend, edge, box, 1)
-            x += sw + 3
-            label = font.render(name, True, TEXT)
-            legend.blit(label, (x, (h - label.get_height()) // 2))
-            x += label.get_width() + 10
-        return legend
+                pg.draw.rect(surf, fill, box)
+                pg.draw.rect(surf, edge, box, 2 if name == "carried" else 1)
+            small.draw(surf, name, x + sw + 3, y)
+            x += need
+        return y + h
+
+    def _draw_keys(self, surf: pygame.Surface, x: int, y: int, width: int | None = None) -> None:
+        small = self._small
+        state = "PAUSED   " if self.paused else ""
+        line = f"{state}{KEYS}   ({self.fps:g} fps)"
+        if width is not None and small.width(line) > width:      # two lines in a narrow panel
+            parts = KEYS.split("   ")
+            half = (len(parts) + 1) // 2
+            small.draw(surf, state + "   ".join(parts[:half]), x, y, MUTED)
+            small.draw(surf, "   ".join(parts[half:]) + f"   ({self.fps:g} fps)", x, y + small.line, MUTED)
+        else:
+            small.draw(surf, line, x, y, MUTED)
 
     # ------------------------------------------------------------------ output
-    def render(self, sim: GatheringSimulation) -> np.ndarray | None:
-        """Draw ``sim``'s current state.
+    def render(self, sim: GatheringSimulation, **options: Any) -> np.ndarray | None:
+        """Draw ``sim``'s current state; ``options`` override render options for this call only.
 
         Returns:
-            ``"rgb_array"``: the frame, a new ``(size_px, size_px, 3)`` uint8 array (rows =
-            screen y, top = north). ``"human"``: None (the frame is shown in a window).
+            ``"rgb_array"``: the frame, a new ``(size_px, size_px + panel_px, 3)`` uint8 array
+            (rows = screen y, top = north). ``"human"``: None (the frame is shown in a window).
         """
-        surf = self.draw(sim)
-        pg = self._pg
-        if self.render_mode == "rgb_array":
-            view = pg.surfarray.pixels3d(surf)             # (W, H, 3) view, locks the surface
+        if options:
+            saved = self._options
+            self.set_options(**options)
             try:
-                frame = np.ascontiguousarray(view.transpose(1, 0, 2))
+                return self.render(sim)
             finally:
-                del view
-            return frame
+                self._configure(saved)
+        if self.render_mode == "rgb_array":
+            return _surface_to_array(self._pg, self.draw(sim))
+        self._show(sim)
+        return None
+
+    def frame(self, sim: GatheringSimulation, **options: Any) -> np.ndarray:
+        """The frame as an array in either render mode (no window involved)."""
+        if options:
+            saved = self._options
+            self.set_options(**options)
+            try:
+                return self.frame(sim)
+            finally:
+                self._configure(saved)
+        return _surface_to_array(self._pg, self.draw(sim))
+
+    def _show(self, sim: GatheringSimulation) -> None:
+        """``"human"``: show the frame, handle keys; while paused, wait for keys here."""
+        pg = self._pg
         if self._window is None:
             try:
                 pg.display.init()
-                self._window = pg.display.set_mode((self.size_px, self.size_px))
+                self._window = pg.display.set_mode(self._surface.get_size())
             except pg.error as err:
                 raise RuntimeError(
                     f"render_mode='human' could not open a window ({err}); "
                     "use render_mode='rgb_array' without a display"
                 ) from None
-            pg.display.set_caption("collective gathering")
+            pg.display.set_caption("collective gathering   " + KEYS)
             self._clock = pg.time.Clock()
-        for event in pg.event.get():
-            if event.type == pg.QUIT:
+        self._handle_events(pg.event.get())
+        while self._window is not None:
+            if self._window.get_size() != self._surface.get_size():
+                self._window = pg.display.set_mode(self._surface.get_size())
+            self._window.blit(self.draw(sim), (0, 0))
+            pg.display.flip()
+            if not self.paused:
+                self._clock.tick(self.fps)
+                return
+            if self._handle_events([pg.event.wait(200)]):
+                return
+
+    def _handle_events(self, events: Sequence[Any]) -> bool:
+        """Apply window events; True if a single step was asked for (or the window closed)."""
+        pg = self._pg
+        step = False
+        for event in events:
+            if event.type == pg.QUIT or (event.type == pg.KEYDOWN and event.key in (pg.K_ESCAPE, pg.K_q)):
                 self.close()
-                return None
-        self._window.blit(surf, (0, 0))
-        pg.display.flip()
-        self._clock.tick(self.fps)
-        return None
+                return True
+            if event.type != pg.KEYDOWN:
+                continue
+            if event.key == pg.K_SPACE:
+                self.paused = not self.paused
+            elif event.key in (pg.K_RIGHT, pg.K_PERIOD):
+                step = True
+            elif event.key in (pg.K_PLUS, pg.K_EQUALS, pg.K_KP_PLUS, pg.K_UP):
+                self.fps = min(self.fps * 2.0, 960.0)
+            elif event.key in (pg.K_MINUS, pg.K_KP_MINUS, pg.K_DOWN):
+                self.fps = max(self.fps / 2.0, 0.5)
+            elif event.key == pg.K_c:
+                self._cone_toggle = (self._cone_toggle + 1) % 3
+        return step
 
     def close(self) -> None:
         """Close the ``"human"`` window if one is open (safe to call more than once)."""
         if self._window is not None:
             self._window = None
             self._clock = None
+            self.paused = False
             self._pg.display.quit()
+
+
+# ---------------------------------------------------------------------- figures
+def film_strip(frames: Sequence[np.ndarray], captions: Sequence[str] | None = None,
+               gap_px: int = 8) -> np.ndarray:
+    """Frames side by side (``gap_px`` of page colour between them), a caption under each.
+
+    Args:
+        frames: equally shaped ``(H, W, 3)`` uint8 arrays.
+        captions: one text per frame (e.g. ``"step 300"``), or None for none.
+
+    Returns:
+        ``(H + caption band, n * W + (n - 1) * gap_px, 3)`` uint8.
+    """
+    frames = [np.asarray(f) for f in frames]
+    if not frames:
+        raise ValueError("film_strip: no frames; allowed: one or more frames")
+    shape = frames[0].shape
+    if len(shape) != 3 or shape[2] != 3:
+        raise ValueError(f"film_strip: frames must have shape (H, W, 3); frame 0 has {shape}")
+    for i, f in enumerate(frames):
+        if f.shape != shape:
+            raise ValueError(f"film_strip: frame {i} has shape {f.shape}; frame 0 has {shape}")
+    if captions is not None and len(captions) != len(frames):
+        raise ValueError(f"film_strip: {len(captions)} captions for {len(frames)} frames; allowed: one per frame")
+    if isinstance(gap_px, bool) or not isinstance(gap_px, (int, np.integer)) or gap_px < 0:
+        raise ValueError(f"film_strip: gap_px={gap_px!r}; allowed: an integer >= 0")
+    h, w = shape[:2]
+    os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+    import pygame as pg
+
+    text = _Text(pg, max(13, h // 32))
+    band = text.line + 8 if captions is not None and text.font is not None else 0
+    n = len(frames)
+    strip = pg.Surface((n * w + (n - 1) * gap_px, h + band))
+    strip.fill(PAGE)
+    for i, f in enumerate(frames):
+        x = i * (w + gap_px)
+        strip.blit(pg.surfarray.make_surface(np.ascontiguousarray(f.transpose(1, 0, 2)).astype(np.uint8)), (x, 0))
+        if band:
+            text.draw(strip, captions[i], x + (w - text.width(captions[i])) // 2, h + 4)
+    return _surface_to_array(pg, strip)
+
+
+def sensor_layout(morphology: Morphology | Sequence, size_px: int = 480, title: str = "") -> np.ndarray:
+    """One robot's sensors from above, like the paper's Figure 3 (middle), plus the table.
+
+    The robot (heading up) is drawn large; each sensor's cone starts at its mount point on the
+    rim (``bearing``), points along ``bearing + orientation`` and opens ``fov``. Cone length is
+    proportional to ``range`` (the longest fills the picture; none shorter than a fifth of it),
+    so cones are not to scale with the body. Numbers match the table's rows; a square at the
+    centre marks a bottom sensor.
+
+    Returns:
+        ``(size_px, size_px + table width, 3)`` uint8.
+    """
+    morphology = Morphology.coerce(morphology)
+    if isinstance(size_px, bool) or not isinstance(size_px, (int, np.integer)) or size_px < 64:
+        raise ValueError(f"sensor_layout: size_px={size_px!r}; allowed: an integer >= 64")
+    os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+    import pygame as pg
+
+    text = _Text(pg, max(13, size_px // 30))
+    gap = max(6, text.width("00"))
+    margin = max(8, size_px // 40)
+    table_w = text.table_columns(gap)[2] + 2 * margin if text.font is not None else 0
+    surf = pg.Surface((size_px + table_w, size_px))
+    surf.fill(PAGE)
+    top = margin + (text.line + 4 if title else 0)
+    if title:
+        text.draw(surf, title, margin, margin)
+    c = np.array([0.5 * size_px, 0.5 * (size_px + top)])
+    reach = 0.5 * size_px - top * 0.5 - margin                     # centre to the picture's edge
+    body = 0.2 * reach
+    longest = max((s.range for s in morphology if s.type != "bottom"), default=1.0)
+
+    def screen(angle: float, dist: float, origin: np.ndarray = c) -> list[float]:
+        # heading = up: world angle a (CCW from heading) -> screen direction (-sin a, -cos a)
+        return [origin[0] - dist * math.sin(angle), origin[1] - dist * math.cos(angle)]
+
+    polygons, labels = [], []
+    for i, s in enumerate(morphology):
+        if s.type == "bottom":
+            continue
+        length = (reach - body) * max(0.2, s.range / longest)
+        mount = np.array(screen(s.bearing, body))
+        axis = s.bearing + s.orientation
+        k = _arc_points(length, s.fov)
+        arc = [screen(axis + a, length, mount) for a in np.linspace(-0.5 * s.fov, 0.5 * s.fov, k)]
+        polygons.append((s.type, [mount.tolist()] + arc))
+        labels.append((i, s.type, mount, screen(axis, 0.55 * length + 0.5 * text.line, mount)))
+    layer = pg.Surface(surf.get_size(), pg.SRCALPHA)
+    layer.set_clip(pg.Rect(0, top, size_px, size_px - top))
+    _draw_cone_layer(pg, layer, surf, polygons)
+    pg.draw.circle(surf, (90, 90, 90), c.tolist(), body)
+    pg.draw.circle(surf, ROBOT, c.tolist(), body, 2)
+    pg.draw.line(surf, HEADING, c.tolist(), screen(0.0, body * 0.9), 3)
+    text.draw(surf, "heading", int(c[0]) + 4, int(c[1] - body) - text.line - 2, MUTED)
+    if any(s.type == "bottom" for s in morphology):
+        sq = max(4, int(body * 0.25))
+        pg.draw.rect(surf, SENSOR_COLOURS["bottom"], pg.Rect(int(c[0]) - sq, int(c[1]) - sq, 2 * sq, 2 * sq))
+        idx = next(i for i, s in enumerate(morphology) if s.type == "bottom")
+        text.draw(surf, str(idx), int(c[0]) - text.width(str(idx)) // 2, int(c[1]) - text.line // 2, HEADING)
+    for i, kind, mount, at in labels:
+        pg.draw.circle(surf, SENSOR_COLOURS[kind], mount.tolist(), max(3, int(body * 0.12)))
+        text.draw(surf, str(i), int(at[0]) - text.width(str(i)) // 2, int(at[1]) - text.line // 2, TEXT)
+    if text.font is not None:
+        x = size_px + margin
+        text.draw(surf, f"{len(morphology)} sensors", x, top)
+        text.draw_table(surf, morphology, x, top + text.line + 4, gap)
+        text.draw(surf, "cone length proportional to range", x, size_px - margin - text.line, MUTED)
+    return _surface_to_array(pg, surf)
+
+
+def save_png(image: np.ndarray, path: str | os.PathLike) -> Path:
+    """Write an ``(H, W, 3)`` uint8 image as PNG (parent folders are created)."""
+    path = Path(path)
+    if path.suffix.lower() != ".png":
+        raise ValueError(f"picture file {str(path)!r} has suffix {path.suffix!r}; allowed: '.png'")
+    import imageio.v2 as imageio
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    imageio.imwrite(path, np.asarray(image, dtype=np.uint8))
+    return path
 
 
 def save_video(frames: Sequence[np.ndarray], path: str | os.PathLike, fps: int = 20) -> Path:
