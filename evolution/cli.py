@@ -87,10 +87,17 @@ def evolve_main(argv: list[str] | None = None) -> int:
     return 0
 
 
+_REPLAY_FLAGS = {"size_px": "--size", "cones": "--cones", "view": "--view", "trail": "--trail",
+                 "panel": "--no-panel", "min_robot_px": "--min-robot-px", "strip": "--strip",
+                 "png": "--png", "sensors_png": "--sensors-png"}
+"""Render option (and replay argument) -> the ``gathering-replay`` flag that sets it."""
+
+
 def replay_main(argv: list[str] | None = None) -> int:
-    """``gathering-replay CHAMPION.json [--environment N] [--out team.gif]``."""
+    """``gathering-replay CHAMPION.json [--environment N] [--out team.gif] [render options]``."""
     parser = argparse.ArgumentParser(prog="gathering-replay",
-                                     description="Replay an evolved team and save the episode as GIF/MP4.")
+                                     description="Replay an evolved team and save the episode as GIF/MP4 "
+                                                 "(pictures: --png, --strip, --sensors-png; see docs/rendering.md).")
     parser.add_argument("champion", type=Path, help="champion JSON written by gathering-evolve")
     parser.add_argument("--environment", type=int, choices=(1, 2, 3), help="preset (default: the one it evolved in)")
     parser.add_argument("--steps", type=int, help="episode length (default: the evolved max_cycles)")
@@ -98,11 +105,28 @@ def replay_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("team.gif"), help=".gif or .mp4")
     parser.add_argument("--frame-every", type=int, default=10, help="record every k-th step")
     parser.add_argument("--fps", type=int, default=15)
-    parser.add_argument("--png", type=Path, help="also save the last frame as a PNG picture")
+    parser.add_argument("--png", type=Path, help="also save the last frame (or with --strip a film strip) as PNG")
+    look = parser.add_argument_group("what the frames show (docs/rendering.md)")
+    look.add_argument("--cones", help="whose sensor cones: auto (default), all, none or robot indices like 0,3")
+    look.add_argument("--view", help="full (default), zone, or follow:K to follow robot K")
+    look.add_argument("--size", type=int, help="side of the arena view in pixels (default 640)")
+    look.add_argument("--trail", type=int, help="draw each robot's path over its last K steps (default 0)")
+    look.add_argument("--no-panel", action="store_true", help="no information panel beside the arena")
+    look.add_argument("--min-robot-px", type=int, help="smallest robot radius in pixels (default 4)")
+    look.add_argument("--strip", help="with --png: film strip of the frames at these steps, e.g. 0,600,1200")
+    look.add_argument("--sensors-png", type=Path, help="also save the team's sensor layout (like the paper's Figure 3)")
     args = parser.parse_args(argv)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    from gathering_env.render import RenderOptionError
+
     from .champion import ChampionError, load_champion
     from .replay import replay
+
+    render_options = {name: value for name, value in (
+        ("cones", args.cones), ("view", args.view), ("size_px", args.size), ("trail", args.trail),
+        ("min_robot_px", args.min_robot_px)) if value is not None}
+    if args.no_panel:
+        render_options["panel"] = False
 
     try:
         champion = load_champion(args.champion)
@@ -112,15 +136,21 @@ def replay_main(argv: list[str] | None = None) -> int:
         if args.steps is not None:
             env_config["max_cycles"] = args.steps
         info, path, frames = replay(champion, env_config, args.seed, args.out, args.frame_every, args.fps,
-                                    png=args.png)
+                                    png=args.png, render_options=render_options, strip=args.strip,
+                                    sensors_png=args.sensors_png)
     except ChampionError as err:
         return _fail(str(err))
+    except RenderOptionError as err:
+        return _fail(f"{_REPLAY_FLAGS.get(err.option, err.option)}: {err.problem}; allowed: {err.allowed}")
     except ValueError as err:
         return _fail(str(err))
     print(f"{champion.experiment or 'champion'} ({champion.method}, {len(champion.morphology)} sensors) in "
           f"environment {env_config.get('environment')}: ft = {info['task_performance']:.2f}, gathered "
           f"{info['gathered_value']:.0f}/{info['total_value']:.0f} in {info['steps']} steps")
     print(f"wrote {path} ({frames} frames)")
+    for picture in (args.png, args.sensors_png):
+        if picture is not None:
+            print(f"wrote {picture}")
     return 0
 
 

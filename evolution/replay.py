@@ -1,39 +1,95 @@
-"""Replay a champion's team in the environment and record it."""
+"""Replay a champion's team in the environment and record it: video, picture, film strip, sensors."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from gathering_env import parallel_env
-from gathering_env.render import save_video
+from gathering_env.render import RenderOptionError, film_strip, save_png, save_video, sensor_layout
 
 from .champion import Champion
 
 
+def parse_steps(value: str | Sequence[int], max_cycles: int) -> list[int]:
+    """Film-strip steps: ``"0,300,600"`` or a list of ints, each in 0..max_cycles, kept in order."""
+    allowed = f"comma-separated steps in 0..{max_cycles} (e.g. '0,{max_cycles // 2},{max_cycles}')"
+    if isinstance(value, str):
+        try:
+            steps = [int(part) for part in value.split(",")]
+        except ValueError:
+            raise RenderOptionError("strip", f"{value!r} is not a list of steps", allowed) from None
+    else:
+        steps = list(value)
+        if not all(isinstance(s, (int, np.integer)) and not isinstance(s, bool) for s in steps):
+            raise RenderOptionError("strip", f"{value!r} is not a list of steps", allowed)
+    if not steps:
+        raise RenderOptionError("strip", "no steps given", allowed)
+    bad = [s for s in steps if not 0 <= s <= max_cycles]
+    if bad:
+        raise RenderOptionError("strip", f"step {bad[0]} is outside the episode", allowed)
+    return [int(s) for s in steps]
+
+
 def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
-           frame_every: int = 10, fps: int = 15, png: Path | None = None) -> tuple[dict[str, Any], Path, int]:
+           frame_every: int = 10, fps: int = 15, png: Path | None = None,
+           render_options: dict[str, Any] | None = None, strip: str | Sequence[int] | None = None,
+           sensors_png: Path | None = None) -> tuple[dict[str, Any], Path, int]:
     """Run one episode of the champion's team with rendering; returns (final info, video path, frames).
 
-    ``png``: also save the last frame there.
+    Args:
+        render_options: what the frames show (``gathering_env.render``: cones, view, size_px,
+            trail, panel, min_robot_px).
+        png: also save a picture there: the last frame, or with ``strip`` a film strip.
+        strip: steps whose frames (arena only, captioned) go side by side into ``png``. If the
+            episode ends before a step, that panel shows the last step.
+        sensors_png: also save the morphology's sensor layout (paper Figure 3, middle) there.
+
+    Raises:
+        RenderOptionError (a ValueError) for a bad render option or strip step, before the run.
     """
-    env = parallel_env(render_mode="rgb_array", **env_config)
+    for option, path in (("png", png), ("sensors_png", sensors_png)):
+        if path is not None and Path(path).suffix.lower() != ".png":
+            raise RenderOptionError(option, f"{str(path)!r} has suffix {Path(path).suffix!r}", "a .png file")
+    env = parallel_env(render_mode="rgb_array", render_options=render_options, **env_config)
+    steps = parse_steps(strip, env.config.max_cycles) if strip is not None else []
+    if steps and png is None:
+        raise RenderOptionError("strip", "a film strip needs a picture file", "--png FILE.png with --strip")
+    if sensors_png is not None:
+        title = f"{champion.experiment or 'champion'} ({champion.method}): sensors of every robot"
+        save_png(sensor_layout(champion.morphology, title=title), sensors_png)
     obs_dict, _ = env.reset(seed=seed, options={"morphology": champion.morphology})
     obs = np.stack([obs_dict[a] for a in env.possible_agents])
     frames = [env.render()]
+    panels: dict[int, np.ndarray] = {}
+    captions: dict[int, str] = {}
+
+    def snap(step: int) -> None:
+        sim = env.sim
+        panels[step] = env.render(panel=False)
+        captions[step] = f"step {sim.steps}: value {sim.gathered_value:g} / {sim.total_value:g}"
+
+    if 0 in steps:
+        snap(0)
     step = 0
     while env.agents:
         obs, _, terminated, truncated = env.step_batch(champion.controller.act(obs))
         step += 1
         if step % frame_every == 0 or terminated or truncated:
             frames.append(env.render())
+        if step in steps:
+            snap(step)
+    for s in steps:                                  # the episode ended before these steps
+        if s not in panels:
+            snap(s)
     info = env.team_info()
     env.close()
     if png is not None:
-        import imageio.v2 as imageio
-
-        Path(png).parent.mkdir(parents=True, exist_ok=True)
-        imageio.imwrite(png, frames[-1])
+        if steps:
+            save_png(film_strip([panels[s] for s in steps], [captions[s] for s in steps]), png)
+        else:
+            save_png(frames[-1], png)
     return info, save_video(frames, out, fps=fps), len(frames)

@@ -382,6 +382,7 @@ class Renderer:
         scale: pixels per world unit (of the last frame drawn, for the follow view).
         arena_rect: (left, top, width, height) of the arena floor in pixels (idem).
         panel_px: width of the panel in pixels (0 without it).
+        sparkline_rect: the panel's sparkline box (a ``pygame.Rect``) once a panel was drawn.
     """
 
     def __init__(self, config: WorldConfig, render_mode: str, size_px: int = DEFAULT_SIZE_PX,
@@ -677,7 +678,8 @@ class Renderer:
         spark_h = max(24, size // 10)
         small.draw(surf, "gathered value over the episode", x0, y, MUTED)
         y += small.line + 2
-        self._draw_sparkline(surf, pg.Rect(x0, y, width, spark_h), sim.total_value)
+        self.sparkline_rect = pg.Rect(x0, y, width, spark_h)
+        self._draw_sparkline(surf, self.sparkline_rect, sim.total_value)
         y += spark_h + m
         # morphology table
         text.draw(surf, f"sensors ({len(sim.morphology)}, every robot)", x0, y)
@@ -812,7 +814,7 @@ class Renderer:
                 ) from None
             pg.display.set_caption("collective gathering   " + KEYS)
             self._clock = pg.time.Clock()
-        self._handle_events(pg.event.get())
+        step = self._handle_events(pg.event.get())
         while self._window is not None:
             if self._window.get_size() != self._surface.get_size():
                 self._window = pg.display.set_mode(self._surface.get_size())
@@ -821,8 +823,9 @@ class Renderer:
             if not self.paused:
                 self._clock.tick(self.fps)
                 return
-            if self._handle_events([pg.event.wait(200)]):
+            if step:
                 return
+            step = self._handle_events([pg.event.wait(200)])
 
     def _handle_events(self, events: Sequence[Any]) -> bool:
         """Apply window events; True if a single step was asked for (or the window closed)."""
