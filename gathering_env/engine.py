@@ -17,6 +17,7 @@ out: they are not stepped and keep their last state until ``reset_world``.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 
 import numpy as np
@@ -44,6 +45,9 @@ class CompiledWorlds:
         self.total_value = config.total_value
         self.worlds = [GatheringWorld(config) for _ in range(self.num_worlds)]
         self.morphology: Morphology | None = None
+        self.timings: dict[str, float] | None = None
+        """Set to a dict to accumulate seconds per phase of ``step`` (drive, physics,
+        settle, sensing) — what the benchmarks report; None (default) records nothing."""
 
     # ------------------------------------------------------------------ episodes
     def reset(self, rngs: Sequence[np.random.Generator], morphology: Morphology) -> None:
@@ -129,6 +133,8 @@ class CompiledWorlds:
 
         Updates the state arrays, ``obs``, ``reward``, ``steps``, ``terminated``,
         ``truncated`` and ``active`` (worlds that end are masked out)."""
+        clock = time.perf_counter
+        t0 = clock()
         active = self.active
         stepped = active.copy()
         kernels.drive(wheels, self.robot_pos, self.robot_angle, self.robot_attached, self.control_rows,
@@ -136,6 +142,7 @@ class CompiledWorlds:
         substeps = self.config.physics_substeps
         h = self.config.dt / substeps
         vel = self._vel_rows
+        t1 = clock()
         for w, world in enumerate(self.worlds):
             if not active[w]:
                 continue
@@ -144,6 +151,7 @@ class CompiledWorlds:
             for _ in range(substeps):
                 space.step(h)
             world.fetch_raw()
+        t2 = clock()
         count = kernels.settle(
             self.raw, self.robot_rows, self.block_rows, active, self.block_half, self.block_need,
             self.block_value, self.params, self.flags, self.robot_pos, self.robot_angle, self.block_pos,
@@ -152,7 +160,13 @@ class CompiledWorlds:
             self._events, self._weld_points)
         if count:
             self._apply_events(count)
+        t3 = clock()
         self.sense(stepped)
+        if self.timings is not None:
+            t4 = clock()
+            for phase, seconds in (("drive", t1 - t0), ("physics", t2 - t1), ("settle", t3 - t2),
+                                   ("sensing", t4 - t3)):
+                self.timings[phase] = self.timings.get(phase, 0.0) + seconds
 
     def _apply_events(self, count: int) -> None:
         """The pymunk joints of this step's attachments and releases (arrays are up to date)."""

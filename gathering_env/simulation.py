@@ -87,8 +87,13 @@ class GatheringSimulation:
     # ------------------------------------------------------------------ statistics
     def blocks_gathered_by_type(self) -> tuple[int, int, int]:
         """Gathered blocks per type (small, medium, large)."""
-        counts = np.bincount(self.world.block_type[self.gathered], minlength=3)
-        return (int(counts[0]), int(counts[1]), int(counts[2]))
+        key = self.gathered.tobytes()
+        cached = self.__dict__.get("_by_type")
+        if cached is None or cached[0] != key or cached[1] is not self.world.block_type:
+            counts = np.bincount(self.world.block_type[self.gathered], minlength=3)
+            cached = (key, self.world.block_type, (int(counts[0]), int(counts[1]), int(counts[2])))
+            self._by_type = cached
+        return cached[2]
 
     def task_performance(self) -> float:
         """Paper eq. 1 for the episode so far (final once the episode has ended)."""
