@@ -179,10 +179,14 @@ class CompiledWorlds:
 
     # ------------------------------------------------------------------ pickling
     def __getstate__(self) -> dict:
-        return dict(self.__dict__)
+        state = dict(self.__dict__)
+        state.pop("_vel_rows", None)
+        return state
 
     def __setstate__(self, state: dict) -> None:
+        """Views do not survive pickling: make the worlds' arrays views of ours again."""
         self.__dict__.update(state)
-        if self.morphology is not None and hasattr(self, "raw"):
+        if hasattr(self, "raw"):
+            self._vel_rows = list(self.vel)
             for w in range(self.num_worlds):
                 self._bind(w)

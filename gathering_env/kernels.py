@@ -95,6 +95,7 @@ def _wall_distance(mx, my, hx, hy, cos_half, sin_half, width, height):
             cos_d, sin_d, perp = -hy, abs(-hx), my
         else:
             cos_d, sin_d, perp = hy, abs(hx), height - my
+        perp = max(perp, 0.0)   # a mount outside the arena (robot overlapping a wall) touches it
         if cos_d >= cos_half:
             cos_eff = 1.0
         else:
@@ -521,3 +522,30 @@ def settle(raw, robot_rows, block_rows, active, block_half, block_need, block_va
         if terminated[w] or truncated[w]:
             active[w] = False
     return count
+
+
+class CompiledSensorBank:
+    """``sense`` for one team, with the interface of the numpy ``sensing.SensorBank``.
+
+    Args: as ``SensorBank``: morphology, config, block_half_sizes (B,), block_needs (B,).
+    """
+
+    def __init__(self, morphology, config, block_half_sizes, block_needs) -> None:
+        self.num_sensors = len(morphology)
+        self.table = sensor_table(morphology)
+        self.params, self.flags = world_params(config)
+        self.block_half = np.asarray(block_half_sizes, dtype=np.float64)
+        self.block_need = np.asarray(block_needs, dtype=np.float64)
+        self._active = np.ones(1, dtype=np.bool_)
+
+    def read(self, robot_pos, robot_angle, block_pos, block_angle, dtype=np.float32) -> np.ndarray:
+        """(N, S) readings (``dtype`` float32 as the env's observations, or float64)."""
+        n = len(robot_angle)
+        out = np.zeros((1, n, self.num_sensors), dtype=dtype)
+        sense(np.ascontiguousarray(robot_pos, dtype=np.float64).reshape(1, n, 2),
+              np.ascontiguousarray(robot_angle, dtype=np.float64).reshape(1, n),
+              np.ascontiguousarray(block_pos, dtype=np.float64).reshape(1, -1, 2),
+              np.ascontiguousarray(block_angle, dtype=np.float64).reshape(1, -1),
+              self.block_half, self.block_need, self.table, self.params, self.flags, self._active, out)
+        return out[0]
+

@@ -1,3 +1,4 @@
+
 """The vectorised sensing kernel agrees with a plain per-robot, per-sensor, per-object loop.
 
 The reference below is written independently of ``gathering_env.sensing`` from SPEC
@@ -10,12 +11,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gathering_env.config import WorldConfig
-from gathering_env.sensing import SensorBank
+from gathering_env.sensing import sensor_bank
 from gathering_env.sensors import SENSOR_TYPES, Morphology, SensorSpec
+
+pytestmark = pytest.mark.usefixtures("both_kernels")  # every test here runs on both kernels
 
 
 def _angle_diff(a: float, b: float) -> float:
@@ -134,7 +138,7 @@ def test_kernel_matches_reference(scene):
     block_angle = rng.uniform(-math.pi, math.pi, b)
     block_half = rng.choice([0.2, 0.3, 0.4], b)
     block_need = rng.choice([1, 2, 3], b)
-    bank = SensorBank(morph, cfg, block_half, block_need)
+    bank = sensor_bank(morph, cfg, block_half, block_need)
     got = bank.read(robot_pos, robot_angle, block_pos, block_angle)
     want = reference_read(list(morph), cfg, robot_pos.tolist(), robot_angle.tolist(),
                           block_pos.tolist(), block_angle.tolist(), block_half.tolist(), block_need.tolist())
