@@ -194,7 +194,8 @@ def breed(candidates: list[int], genomes: dict[int, Any], score: dict[int, float
             ancestors[key] = (p1, p2)
         else:
             p1 = random.choice(parents)
-            child.configure_crossover(genomes[p1], genomes[p1], gcfg)  # a copy of one parent
+            copy = _Scored(genomes[p1], 0.0)
+            child.configure_crossover(copy, copy, gcfg)  # a copy of one parent
             ancestors[key] = (p1,)
             if op is not None and op != "crossover":
                 child.apply_operator(op, gcfg)
