@@ -223,7 +223,8 @@ def test_crossover_takes_disjoint_genes_from_the_better_score_not_fitness(tmp_pa
     for better, expect in ((1, True), (2, False)):            # ... but the rank score decides
         score = {1: 10.0, 2: 5.0} if better == 1 else {1: 5.0, 2: 10.0}
         keys = iter(range(100, 200))
-        for child in breed([1, 2], genomes, score, 20, config, lambda: next(keys), {}).values():
+        new_key = keys.__next__
+        for child in breed([1, 2], genomes, score, 20, config, new_key, {}).values():
             assert all((k in child.connections) is expect for k in dropped)
 
 
