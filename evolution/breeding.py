@@ -14,7 +14,8 @@ each species' offspring with ``breed``, so Table 4 compares selection and nothin
    from the parent with the better score, so in MO the better-ranked one), or a copy of one
    parent changed by exactly one mutation operator of the genome class (``weights``,
    ``add_node``, ``add_link``, ``remove_link``, ``remove_node``; NEAT-M adds its sensor
-   operators).
+   operators). A species with a single parent cannot cross over: a drawn crossover becomes
+   a mutation operator drawn from the others.
 
 The probabilities live in the genome's config section (they differ between HyperNEAT-M and
 NEAT-M, and a genome class knows its operators)::
@@ -184,6 +185,8 @@ def breed(candidates: list[int], genomes: dict[int, Any], score: dict[int, float
         child = config.genome_type(key)
         if gcfg.variation == "one_operator":
             op = random.choices(names, weights)[0]
+            if op == "crossover" and len(parents) < 2 and sum(weights[1:]) > 0:
+                op = random.choices(names[1:], weights[1:])[0]  # one parent: a mutation instead
             crossover = op == "crossover"
         else:
             op = None
@@ -251,9 +254,10 @@ class NEATReproduction(neat.DefaultReproduction):
             s.members = {}
             species.species[s.key] = s
             ranked = sorted(members, key=lambda k: (members[k].fitness, k), reverse=True)
-            for k in ranked[:cfg.elitism]:
+            elites = ranked[:cfg.elitism]
+            for k in elites:
                 new_population[k] = members[k]
-            n -= min(cfg.elitism, n)
+            n -= len(elites)
             score = {k: float(members[k].fitness) for k in ranked}
             new_population.update(breed(ranked, members, score, n, config, lambda: next(self.genome_indexer),
                                         self.ancestors))
