@@ -3,51 +3,28 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
+import shutil
 
 import numpy as np
 import pytest
+import small_runs
 
 from evolution.analysis import analyse
 from evolution.champion import genome_from_dict, load_champion
-from evolution.cli import analyze_main, evolve_main
+from evolution.cli import analyze_main
 from evolution.evaluate import evaluate, trial_seed
 from evolution.pareto import non_dominated_fronts
 from evolution.reevaluate import CACHE_FILE, _run_setup, heldout_seeds, reevaluate_run, training_seeds
 
-TINY = """
-[experiment]
-name = "{name}"
-method = "{method}"
-objectives = {objectives}
-generations = 2
-population = 6
-trials = 2
-seed = {seed}
-
-[environment]          # a small world where a few blocks get gathered, so ft varies
-environment = 1
-arena_width = 6.0
-arena_height = 6.0
-zone_width = 6.0
-zone_depth = 2.0
-block_counts = [8, 0, 0]
-max_cycles = 80
-num_robots = 10
-"""
-
-
-def run_tiny(root: Path, name: str, objectives: str, method: str = "hyperneat-m", seed: int = 5) -> Path:
-    exp = root / f"{name}.toml"
-    exp.write_text(TINY.format(name=name, method=method, objectives=objectives, seed=seed))
-    assert evolve_main([str(exp), "--out", str(root / name), "--workers", "1", "--no-progress"]) == 0
-    return root / name
-
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
+    """Copies of the shared small runs (re-evaluation writes its cache into them)."""
+    _, so, _, mo = small_runs.build(tmp_path_factory)
     root = tmp_path_factory.mktemp("reeval")
-    return run_tiny(root, "so", '["task"]'), run_tiny(root, "mo", '["task", "morphology"]', method="neat-m")
+    shutil.copytree(so, root / "so")
+    shutil.copytree(mo, root / "mo")
+    return root / "so", root / "mo"
 
 
 def test_heldout_seeds_are_disjoint_from_training():
@@ -131,8 +108,6 @@ def test_analysis_with_reevaluation_is_reproducible(runs, tmp_path):
 
 def test_reevaluation_never_overwrites_a_foreign_file(runs, tmp_path, capsys):
     so, _ = runs
-    import shutil
-
     copy = tmp_path / "copy"
     shutil.copytree(so, copy)
     (copy / CACHE_FILE).write_text("my notes\n")

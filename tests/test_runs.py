@@ -10,55 +10,22 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import small_runs
+from small_runs import evolve, experiment_file
 
 from evolution import trainer as trainer_module
 from evolution.champion import genome_from_dict, load_champion
-from evolution.cli import evolve_main
 from evolution.evaluate import Evaluation, evaluate, sensor_statistics, trial_seed
 from evolution.experiment import load_experiment
 from evolution.reevaluate import _run_setup
 from evolution.stats import read_stats, without_timing
 from gathering_env import Morphology, parallel_env
 
-SMALL_WORLD = """
-[environment]          # a small world where a few blocks get gathered, so ft varies
-environment = 1
-arena_width = 6.0
-arena_height = 6.0
-zone_width = 6.0
-zone_depth = 2.0
-block_counts = [8, 0, 0]
-max_cycles = 80
-num_robots = 10
-"""
-
-
-def experiment_file(root: Path, name: str, method: str, objectives: str, generations: int = 3, extra: str = "") -> Path:
-    path = root / f"{name}.toml"
-    path.write_text(f"""
-[experiment]
-name = "{name}"
-method = "{method}"
-objectives = {objectives}
-generations = {generations}
-population = 6
-trials = 2
-seed = 3
-{extra}
-""" + SMALL_WORLD)
-    return path
-
-
-def evolve(exp: Path, out: Path, *more: str) -> None:
-    assert evolve_main([str(exp), "--out", str(out), "--workers", "1", "--no-progress", *more]) == 0
-
 
 @pytest.fixture(scope="module")
 def mo_run(tmp_path_factory):
-    root = tmp_path_factory.mktemp("mo")
-    exp = experiment_file(root, "mo", "neat-m", '["task", "morphology"]')
-    evolve(exp, root / "run")
-    return exp, root / "run"
+    _, _, exp, run = small_runs.build(tmp_path_factory)
+    return exp, run
 
 
 def team_ft(controller, morphology, env_config, seed):
