@@ -34,6 +34,15 @@ def _nearest_on_square(p, centre, half, angle):
     return (centre[0] + qx * c - qy * s, centre[1] + qx * s + qy * c)
 
 
+def _distance_to_square(p, centre, half, angle):
+    """Distance from p to the square, measured in the square's frame (exactly 0 inside; a
+    round trip through world coordinates would leave ~1e-16 and lose ties at distance 0)."""
+    c, s = math.cos(angle), math.sin(angle)
+    rx, ry = p[0] - centre[0], p[1] - centre[1]
+    lx, ly = rx * c + ry * s, -rx * s + ry * c
+    return math.hypot(min(max(lx, -half), half) - lx, min(max(ly, -half), half) - ly)
+
+
 def _wall_distance(mount, axis, half_fov, cfg):
     """Nearest wall point inside the cone, by checking the wall normal and both cone edges."""
     best = math.inf
@@ -74,7 +83,7 @@ def reference_read(morph, cfg, robot_pos, robot_angle, block_pos, block_angle, b
                     seen.append((dist, "robot", 0))
             for b in range(len(block_pos)):
                 q = _nearest_on_square(mount, block_pos[b], block_half[b], block_angle[b])
-                dist = math.hypot(q[0] - mount[0], q[1] - mount[1])
+                dist = _distance_to_square(mount, block_pos[b], block_half[b], block_angle[b])
                 inside_cone = dist < 1e-12 or _angle_diff(math.atan2(q[1] - mount[1], q[0] - mount[0]), axis) <= s.fov / 2 + 1e-12
                 if inside_cone and dist < s.range:
                     seen.append((dist, "block", block_need[b]))
