@@ -14,6 +14,8 @@ Prints, for each kernel, the best of ``--repeats`` runs of:
 and, for the compiled kernel, microseconds per step by phase (physics = pymunk's set, step
 and get; sensing; heuristics + scoring = the drive and settle kernels and the weld joints;
 glue = the rest of the fast path: validation, copies, the wander policy itself excluded).
+Last, the sensing alone (microseconds per team reading, both kernels) for suites of growing
+range: Khepera III, ten 10-unit infrared, ten 25-unit ultrasonics, ten 20-unit cameras.
 The Java original measured ~8 500 steps/s on this machine for the same workload (issue 15).
 """
 
@@ -24,8 +26,10 @@ import time
 
 import numpy as np
 
-from gathering_env import parallel_env
+from gathering_env import Morphology, SensorSpec, parallel_env
+from gathering_env.kernels import CompiledSensorBank
 from gathering_env.policies import WanderTeam
+from gathering_env.sensing import SensorBank
 from gathering_env.vector import VectorSimulation
 
 ENV = dict(environment=2, num_robots=20)
@@ -81,6 +85,41 @@ def run_batch(kernel: str, steps: int, worlds: int) -> float:
     return elapsed
 
 
+SUITES = {
+    "Khepera III": Morphology.khepera_iii(),
+    "10 x infrared 10": Morphology([SensorSpec("infrared", b, 0.0, 10.0, 1.0) for b in np.linspace(-3, 3, 10)]),
+    "10 x ultrasonic 25": Morphology([SensorSpec("ultrasonic", b, 0.0, 25.0, 1.0) for b in np.linspace(-3, 3, 10)]),
+    "10 x camera 20": Morphology([SensorSpec("camera", b, 0.0, 20.0, 1.0) for b in np.linspace(-3, 3, 10)]),
+}
+
+
+def sensing_costs(states: int = 200, repeats: int = 5) -> None:
+    """Microseconds per team reading on world states sampled along a wander episode."""
+    env = parallel_env(**ENV, max_cycles=states * 10, kernel="compiled")
+    obs, _ = env.reset(seed=0)
+    team = WanderTeam(env.morphology, seed=0)
+    w, poses = env.sim.world, []
+    obs = env.sim.observe()
+    for t in range(states * 10):
+        obs, *_ = env.step_batch(team.act(obs))
+        if t % 10 == 0:
+            poses.append((w.robot_pos.copy(), w.robot_angle.copy(), w.block_pos.copy(), w.block_angle.copy()))
+    print(f"sensing alone, microseconds per team reading (20 robots, 15 blocks, {states} states):")
+    print(f"  {'suite':<22}{'compiled':>10}{'numpy':>10}")
+    for name, morph in SUITES.items():
+        row = []
+        for bank_class in (CompiledSensorBank, SensorBank):
+            bank = bank_class(morph, env.config, w.block_half, w.block_need)
+            best = np.inf
+            for _ in range(repeats):
+                t0 = time.perf_counter()
+                for pose in poses:
+                    bank.read(*pose)
+                best = min(best, time.perf_counter() - t0)
+            row.append(1e6 * best / len(poses))
+        print(f"  {name:<22}{row[0]:>10.1f}{row[1]:>10.1f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--steps", type=int, default=10_000, help="steps per timed run (default 10000)")
@@ -112,6 +151,7 @@ def main() -> None:
         print(f"compiled fast path, microseconds per step ({1e6 * total / args.steps:.1f} in all):")
         for name, value in parts.items():
             print(f"  {name:<46}{value:7.1f}")
+    sensing_costs()
 
 
 if __name__ == "__main__":
