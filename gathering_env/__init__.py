@@ -6,6 +6,7 @@ Public names::
     SensorSpec, Morphology, SENSOR_TYPES  sensor suite description and per-type bounds
     morphological_complexity            paper eq. 2 (higher = simpler)
     WorldConfig, ENVIRONMENT_PRESETS    every world parameter, paper Table 2 presets
+    VectorSimulation                    W independent worlds stepped together (gathering_env.vector)
 
 Importing the package registers ``gathering_env/CollectiveGathering-v0`` in PettingZoo's
 registry: ``pettingzoo.make("parallel", "gathering_env/CollectiveGathering-v0", environment=2)``
@@ -19,6 +20,7 @@ from pettingzoo import register as _register
 from .config import ENVIRONMENT_PRESETS, WorldConfig
 from .env import GatheringEnv, env, parallel_env, raw_env
 from .sensors import SENSOR_TYPES, Morphology, SensorSpec, morphological_complexity
+from .vector import VectorSimulation
 
 ENV_ID = "gathering_env/CollectiveGathering-v0"
 TEAM_ENV_ID = "gathering_env/GatheringTeam-v0"
@@ -36,6 +38,7 @@ __all__ = [
     "GatheringEnv",
     "Morphology",
     "SensorSpec",
+    "VectorSimulation",
     "WorldConfig",
     "env",
     "morphological_complexity",
