@@ -9,5 +9,6 @@ champions), ``experiment`` (TOML experiment files), ``analysis``, ``reevaluate``
 (fronts, selection points, held-out re-evaluation, statistical tests, figures), ``cli`` (console scripts).
 """
 
+from gathering_env import __version__
+
 __all__ = ["__version__"]
-__version__ = "0.1.0"
