@@ -13,7 +13,16 @@ import sys
 from pathlib import Path
 
 from .checkpoint import CheckpointError
-from .experiment import METHODS, ExperimentError, load_experiment
+from .experiment import (
+    METHODS,
+    ExperimentError,
+    is_preset_name,
+    load_experiment,
+    neat_config_names,
+    preset_description,
+    preset_names,
+    preset_path,
+)
 
 
 def _fail(message: str) -> int:
@@ -21,14 +30,36 @@ def _fail(message: str) -> int:
     return 2
 
 
+def _list_presets() -> int:
+    for name in preset_names() + neat_config_names():
+        print(f"{name:22s} {preset_description(name)}")
+    return 0
+
+
+def _dump_preset(name: str) -> int:
+    try:
+        path = preset_path(name, neat_configs=True)
+    except ExperimentError as err:
+        return _fail(f"--dump {err}")
+    sys.stdout.write(path.read_text(encoding="utf-8"))
+    return 0
+
+
 def evolve_main(argv: list[str] | None = None) -> int:
-    """``gathering-evolve [EXPERIMENT.toml] [overrides] --out RUN_DIR``."""
+    """``gathering-evolve [PRESET | EXPERIMENT.toml] [overrides] --out RUN_DIR``."""
+    from gathering_env import __version__
+
     parser = argparse.ArgumentParser(
         prog="gathering-evolve",
         description="Co-evolve controllers and sensor morphologies of a robot team (HyperNEAT-M / NEAT-M).",
     )
-    parser.add_argument("experiment", nargs="?", type=Path,
-                        help="TOML experiment file (default: built-in paper defaults; see configs/)")
+    parser.add_argument("experiment", nargs="?",
+                        help="a preset name (S1, quick, ...: see --list) or a TOML experiment file "
+                             "(default: built-in paper defaults)")
+    parser.add_argument("--list", action="store_true", help="list the shipped presets and exit")
+    parser.add_argument("--dump", metavar="PRESET",
+                        help="print a preset's file (e.g. --dump S1 > my.toml) and exit")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("--out", type=Path, help="run directory (default: runs/<name>-seed<seed>)")
     parser.add_argument("--workers", type=int, default=None, help="evaluation processes (default: all cores; 1 = serial)")
     parser.add_argument("--resume", action="store_true", help="continue the run in --out from its newest checkpoint")
@@ -50,6 +81,10 @@ def evolve_main(argv: list[str] | None = None) -> int:
     group.add_argument("--steps", type=int, help="steps per trial (max_cycles)")
     group.add_argument("--robots", type=int, help="team size (num_robots)")
     args = parser.parse_args(argv)
+    if args.list:
+        return _list_presets()
+    if args.dump is not None:
+        return _dump_preset(args.dump)
 
     overrides = {
         "name": args.name, "method": args.method, "seed": args.seed, "generations": args.generations,
@@ -63,7 +98,10 @@ def evolve_main(argv: list[str] | None = None) -> int:
     if args.max_retries < 0:
         return _fail(f"--max-retries={args.max_retries}; allowed: >= 0")
     try:
-        experiment = load_experiment(args.experiment, overrides)
+        experiment_file = args.experiment
+        if experiment_file is not None and is_preset_name(experiment_file):
+            experiment_file = preset_path(experiment_file)
+        experiment = load_experiment(experiment_file, overrides)
         out = args.out or Path("runs") / f"{experiment.name}-seed{experiment.seed}"
         from .trainer import Trainer
 
@@ -163,16 +201,33 @@ def analyze_main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("runs", nargs="+", type=Path, help="run directories written by gathering-evolve")
     parser.add_argument("--out", type=Path, default=Path("report"), help="output directory (default: report/)")
+    from .reevaluate import REEVALUATE_TRIALS
+
+    parser.add_argument("--reevaluate", type=int, default=REEVALUATE_TRIALS, metavar="K",
+                        help="re-run every SO champion and MO front genome K times on held-out seeds and report "
+                             f"those scores (default {REEVALUATE_TRIALS}; cached in each run directory); "
+                             "0 = use the training scores")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="evaluation processes for --reevaluate (default: all cores; 1 = serial)")
+    parser.add_argument("--backend", default="process", help="serial, process or ray (default: process)")
     args = parser.parse_args(argv)
     from .analysis import analyse
+    from .backends import BACKENDS
     from .report import write_report
 
+    if args.reevaluate < 0:
+        return _fail(f"--reevaluate={args.reevaluate}; allowed: an integer >= 0 (0 = training scores)")
+    if args.workers is not None and args.workers < 1:
+        return _fail(f"--workers={args.workers}; allowed: >= 1")
+    if args.backend not in BACKENDS:
+        return _fail(f"--backend={args.backend!r}; allowed: {', '.join(BACKENDS)}")
     try:
-        analysis = analyse(args.runs)
+        analysis = analyse(args.runs, reevaluate=args.reevaluate, workers=args.workers, backend=args.backend)
     except ValueError as err:
         return _fail(str(err))
     path = write_report(analysis, args.out)
     print(f"{len(analysis.runs)} runs, {len(analysis.comparisons)} comparisons -> {path}")
+    print(f"ft used: {analysis.scores}")
     return 0
 
 

@@ -12,7 +12,7 @@ Layout (every key optional except where noted; defaults are the paper's, SPEC se
     trials = 5                   # trials (episodes) per genome, mean ft is the fitness
     convergence_stop = true      # SO only: stop once the best genome gathers all blocks in
                                  # half the allowed steps (mean ft >= 100 + bonus / 2)
-    neat_config = "hyperneat_m.neat.cfg"   # neat-python config, relative to this file
+    neat_config = "hyperneat_m.neat.cfg"   # neat-python config (see "neat_config" below)
 
     [environment]                # any gathering_env keyword: environment, max_cycles, ...
     environment = 2
@@ -23,12 +23,24 @@ Layout (every key optional except where noted; defaults are the paper's, SPEC se
 
 ``load_experiment(path, overrides)`` validates everything and raises ``ExperimentError``
 (a ``ValueError``) naming the file and the key.
+
+``neat_config``: an absolute path is used as is; a relative one is looked up next to the
+experiment file first and, if no such file exists there, among the shipped presets. So a
+preset written out with ``gathering-evolve --dump S1 > my.toml`` keeps working anywhere.
+
+Presets: the top-level ``configs/`` folder of the repository is installed as the package
+``evolution.presets`` (``[tool.setuptools.package-dir]`` in pyproject.toml), so the shipped
+experiment files and neat configs are there after ``pip install`` too. ``presets_dir()``
+finds them; ``preset_names()``, ``preset_path(name)`` and ``preset_description(name)`` name
+them (the description is the first comment line of the file).
 """
 
 from __future__ import annotations
 
+import re
 import tomllib
 from dataclasses import asdict, dataclass, field, fields, replace
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -37,11 +49,73 @@ from gathering_env.config import WorldConfig
 METHODS = ("hyperneat-m", "neat-m")
 OBJECTIVES = ("task", "morphology", "controller")
 DEFAULT_NEAT_CONFIGS = {"hyperneat-m": "hyperneat_m.neat.cfg", "neat-m": "neat_m.neat.cfg"}
-CONFIG_DIR = Path(__file__).resolve().parent.parent / "configs"
+PRESET_PACKAGE = "evolution.presets"
 
 
 class ExperimentError(ValueError):
     """A broken or inconsistent experiment file or override."""
+
+
+def presets_dir() -> Path:
+    """The folder of shipped presets (experiment files and neat configs).
+
+    In a source checkout (also an editable install) it is the checkout's ``configs/``
+    folder; in an installed wheel, the package ``evolution.presets`` that setuptools
+    built from that folder.
+    """
+    checkout = Path(__file__).resolve().parent.parent
+    if (checkout / "pyproject.toml").is_file() and (checkout / "configs" / "__init__.py").is_file():
+        return checkout / "configs"
+    return Path(str(resources.files(PRESET_PACKAGE)))
+
+
+CONFIG_DIR = presets_dir()
+
+
+def preset_names() -> list[str]:
+    """Names of the shipped experiment presets (the ``*.toml`` files, without suffix)."""
+    return sorted(p.stem for p in CONFIG_DIR.glob("*.toml"))
+
+
+def neat_config_names() -> list[str]:
+    """File names of the shipped neat-python configs."""
+    return sorted(p.name for p in CONFIG_DIR.glob("*.neat.cfg"))
+
+
+def preset_path(name: str, neat_configs: bool = False) -> Path:
+    """The file of an experiment preset (``S1``), or with ``neat_configs`` also of a shipped
+    neat config by file name (``hyperneat_m.neat.cfg``).
+
+    Raises:
+        ExperimentError: no such preset; the one-line message lists the known ones.
+    """
+    known = preset_names() + (neat_config_names() if neat_configs else [])
+    if name not in known:
+        raise ExperimentError(f"{name}: unknown preset; known: {', '.join(known)} "
+                              f"(or the path of an experiment file)")
+    return CONFIG_DIR / (name if name.endswith(".cfg") else f"{name}.toml")
+
+
+def preset_description(name: str) -> str:
+    """The one-line description of a preset: the first sentence of its opening comment."""
+    lines = preset_path(name, neat_configs=True).read_text(encoding="utf-8").splitlines()
+    comment = []
+    for line in lines:
+        if not line.startswith("#"):
+            break
+        comment.append(line.lstrip("#").strip())
+    text = " ".join(comment)
+    end = re.search(r"\.(\s|$)", text)
+    return text[: end.start() + 1] if end else text
+
+
+def is_preset_name(arg: str) -> bool:
+    """Whether a command-line EXPERIMENT argument means a preset rather than a file.
+
+    A preset name has no path separator and no ``.toml`` suffix and is not an existing file;
+    anything else is a path, as before presets existed.
+    """
+    return not (any(sep in arg for sep in "/\\") or arg.endswith(".toml") or Path(arg).is_file())
 
 
 @dataclass(frozen=True)

@@ -45,6 +45,18 @@ keyword. ``reset(seed=..., options={"morphology": Morphology | list of sensor di
 ``render_options={"cones": ..., "view": ..., "size_px": ..., "trail": ..., "panel": ...,
 "min_robot_px": ...}`` choose what frames show (``gathering_env.render``, ``docs/rendering.md``);
 ``render(**options)`` overrides them for one frame.
+
+## Kernels
+``kernel="compiled"`` (default) computes everything of a step but pymunk's physics in numba
+kernels; ``kernel="numpy"`` uses the vectorised numpy reference. Both give the same
+episodes (tested bit for bit); the compiled one is several times faster (docs/performance.md).
+The first use of the compiled kernel in a fresh environment compiles it (a few seconds, once;
+the machine code is cached on disk, see ``gathering_env.kernels``).
+
+## Many worlds
+``gathering_env.vector.VectorSimulation(num_worlds, **world_parameters)`` steps W
+independent episodes together (arrays of shape (W, N, ...)); each world's episode is the
+one this env gives for the same seed.
 """
 
 from __future__ import annotations
@@ -149,6 +161,8 @@ class GatheringEnv(ParallelEnv):
             raise RuntimeError(
                 "step() called after the episode ended (or before reset()); call reset() first"
             )
+        if not isinstance(actions, dict):
+            raise TypeError(f"actions must be a dict {{agent: (left, right)}}; got {type(actions).__name__}")
         if actions.keys() != self._agent_index.keys():
             self._explain_action_keys(actions)
         try:
@@ -170,7 +184,7 @@ class GatheringEnv(ParallelEnv):
         terminations = dict.fromkeys(agents, terminated)
         truncations = dict.fromkeys(agents, truncated)
         info = self._team_info()
-        infos = {a: dict(info) for a in agents}
+        infos = {a: info.copy() for a in agents}
         if terminated or truncated:
             self.agents = []
         if self._renderer is not None:
