@@ -1,0 +1,85 @@
+"""``gathering-replay`` pictures: film strips, sensor layouts, render options and their errors."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import imageio.v2 as imageio
+import numpy as np
+import pytest
+
+from evolution.champion import FORMAT, VERSION
+from evolution.cli import replay_main
+from evolution.controller import TeamController
+from gathering_env import Morphology, SensorSpec
+from gathering_env.render import WALL, cone_colour_on
+from gathering_env.render import PAGE as PAGE_COLOUR
+
+
+@pytest.fixture
+def champion(tmp_path):
+    """A hand-made champion: ten long cameras, a random single-layer controller, 8 robots."""
+    sensors = [SensorSpec("camera", bearing=b, orientation=0.0, range=20.0, fov=math.pi / 2)
+               for b in np.linspace(-math.pi, math.pi, 10, endpoint=False)]
+    rng = np.random.default_rng(0)
+    controller = TeamController.single_layer(rng.normal(size=(2, 10)), rng.normal(size=2))
+    doc = {"format": FORMAT, "version": VERSION, "method": "hyperneat-m", "experiment": "handmade",
+           "objectives": {"task": 0.0}, "environment": {"environment": 1, "max_cycles": 40, "num_robots": 8},
+           "morphology": Morphology(sensors).to_dict(), "controller": controller.to_dict()}
+    path = tmp_path / "champion.json"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def wall_runs(row: np.ndarray) -> int:
+    is_wall = (row == np.array(WALL)).all(axis=1).astype(int)
+    return int(np.sum(np.diff(np.concatenate([[0], is_wall])) == 1))
+
+
+def test_film_strip_sensor_layout_and_options(champion, tmp_path, capsys):
+    out, strip, sensors = tmp_path / "team.gif", tmp_path / "strip.png", tmp_path / "sensors.png"
+    assert replay_main([str(champion), "--out", str(out), "--frame-every", "20", "--png", str(strip),
+                        "--strip", "0,10,20,40", "--sensors-png", str(sensors), "--no-panel",
+                        "--size", "200", "--cones", "0,3", "--view", "zone", "--trail", "5"]) == 0
+    printed = capsys.readouterr().out
+    assert str(strip) in printed and str(sensors) in printed
+    frames = imageio.mimread(out)
+    assert len(frames) == 3 and frames[0].shape[:2] == (200, 200)           # --size, --no-panel
+    picture = imageio.imread(strip)[..., :3]
+    assert picture.shape[1] == 4 * 200 + 3 * 8                              # four panels side by side
+    layout = imageio.imread(sensors)[..., :3]
+    tint = np.array(cone_colour_on(PAGE_COLOUR, "camera"))
+    assert (np.abs(layout.astype(int) - tint).max(axis=2) <= 1).mean() > 0.05   # cones drawn
+
+
+def test_film_strip_panels_full_view(champion, tmp_path):
+    strip = tmp_path / "strip.png"
+    assert replay_main([str(champion), "--out", str(tmp_path / "t.gif"), "--png", str(strip),
+                        "--strip", "0,40", "--size", "160"]) == 0
+    picture = imageio.imread(strip)[..., :3]
+    assert wall_runs(picture[80]) == 2 * 2                                  # two arenas, two walls each
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--cones", "3,x"], "error: --cones: '3,x' is not a choice nor a list of robot indices; allowed: "
+                         "'auto', 'all', 'none' or robot indices in 0..7"),
+    (["--cones", "9"], "error: --cones: robot index 9 does not exist (8 robots); allowed:"),
+    (["--view", "top"], "error: --view: 'top' is not a view; allowed: 'full', 'zone' or 'follow:K' with K in 0..7"),
+    (["--view", "follow:8"], "error: --view: robot 8 does not exist"),
+    (["--size", "20"], "error: --size: 20 is not an integer >= 64; allowed: an integer >= 64"),
+    (["--trail", "-2"], "error: --trail: -2 is not an integer >= 0; allowed:"),
+    (["--min-robot-px", "0"], "error: --min-robot-px: 0 is not an integer >= 1; allowed:"),
+    (["--strip", "0,50", "--png", "s.png"], "error: --strip: step 50 is outside the episode; allowed: "
+                                            "comma-separated steps in 0..40"),
+    (["--strip", "0,a", "--png", "s.png"], "error: --strip: '0,a' is not a list of steps; allowed:"),
+    (["--strip", "0,10"], "error: --strip: a film strip needs a picture file; allowed: --png FILE.png"),
+    (["--png", "s.jpg"], "error: --png: 's.jpg' has suffix '.jpg'; allowed: a .png file"),
+    (["--sensors-png", "s.gif"], "error: --sensors-png: 's.gif' has suffix '.gif'; allowed: a .png file"),
+])
+def test_bad_replay_options_exit_2_with_one_line(champion, tmp_path, capsys, monkeypatch, args, message):
+    monkeypatch.chdir(tmp_path)
+    assert replay_main([str(champion), "--out", "team.gif", *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(message) and err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["champion.json"]  # nothing written
