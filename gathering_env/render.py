@@ -81,7 +81,7 @@ HEADING: RGB = (255, 255, 255)
 """Heading mark: a line from near the robot's centre to its rim."""
 FOCUS: RGB = (255, 120, 0)
 """Ring around the robots whose cones are shown when not all robots' cones are."""
-TRAIL: RGB = (110, 110, 200)
+TRAIL: RGB = (70, 70, 220)
 """Colour of the newest trail segment; older segments fade towards the floor colour."""
 TEXT: RGB = (20, 20, 20)
 MUTED: RGB = (110, 110, 110)
@@ -111,7 +111,7 @@ ZONE_MARGIN = 3.0
 """World units shown around the zone in the ``zone`` view."""
 VIEWS = ("full", "zone", "follow:K")
 CONE_CHOICES = ("auto", "all", "none")
-KEYS = "space pause   \u2192 step   +/- speed   c cones   esc close"
+KEYS = "space pause   right step   +/- speed   c cones   esc close"
 """The ``"human"`` window's keys, as listed in the window."""
 
 _CONE_ORDER = [t for t in SENSOR_TYPES if t != "bottom"]
@@ -575,7 +575,7 @@ class Renderer:
         pg = self._pg
         pts = self.to_screen(np.stack(self._positions))               # (T, N, 2), oldest first
         t = len(pts)
-        width = 2 if self.scale >= 30 else 1
+        width = 3 if self.scale >= 30 else 2
         for age in range(t - 1):
             f = (age + 1) / (t - 1)                                   # 1 for the newest segment
             colour = tuple(int(round(a + (b - a) * f)) for a, b in zip(FLOOR, TRAIL))

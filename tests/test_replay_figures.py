@@ -13,8 +13,7 @@ from evolution.champion import FORMAT, VERSION
 from evolution.cli import replay_main
 from evolution.controller import TeamController
 from gathering_env import Morphology, SensorSpec
-from gathering_env.render import WALL, cone_colour_on
-from gathering_env.render import PAGE as PAGE_COLOUR
+from gathering_env.render import PAGE, WALL, cone_colour_on
 
 
 @pytest.fixture
@@ -49,7 +48,7 @@ def test_film_strip_sensor_layout_and_options(champion, tmp_path, capsys):
     picture = imageio.imread(strip)[..., :3]
     assert picture.shape[1] == 4 * 200 + 3 * 8                              # four panels side by side
     layout = imageio.imread(sensors)[..., :3]
-    tint = np.array(cone_colour_on(PAGE_COLOUR, "camera"))
+    tint = np.array(cone_colour_on(PAGE, "camera"))
     assert (np.abs(layout.astype(int) - tint).max(axis=2) <= 1).mean() > 0.05   # cones drawn
 
 
