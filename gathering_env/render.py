@@ -8,8 +8,7 @@ option with a picture):
   smaller than ``MIN_BLOCK_PX``; gathered blocks (``sim.gathered``) are darker with a white
   outline; blocks a robot is welded to (carried) have a magenta outline;
 * robots as dark discs of at least ``min_robot_px`` pixels radius with a heading mark (a white
-  line inside, a stub outside);
-  robots welded to a block (``world.robot_attached >= 0``) are magenta; robots whose cones are
+  line inside, a stub outside); robots welded to a block (``world.robot_attached >= 0``) are magenta; robots whose cones are
   shown while others' are not get an orange ring;
 * sensor cones (circular sectors of radius ``range`` and full angle ``fov`` from the sensor's
   mount point on the rim, as in ``sensing.py``): all cones are drawn into ONE transparent layer
@@ -29,9 +28,17 @@ Render options (``Renderer(...)``, ``parallel_env(render_options={...})``,
                  robot in a follow view, else robot 0).
 ``view``         ``"full"`` (the arena), ``"zone"`` (a square crop around the zone) or
                  ``"follow:K"`` (``FOLLOW_SPAN`` units around robot K, which stays centred).
-``trail``        K >= 0: draw each robot's path over its last K steps (0 = no trails).
+``trail``        K >= 0: draw each robot's path over its last K steps (0 = no trails). Positions
+                 are kept while ``trail`` > 0 when the steps are recorded (``Renderer.record``).
 ``panel``        True: the information panel beside the arena.
 ``min_robot_px`` robots are drawn at least this many pixels in radius (>= 1).
+
+Usage::
+
+    env = parallel_env(render_mode="rgb_array", render_options={"view": "zone", "trail": 100})
+    frame = env.render()                         # (640, 640 + panel, 3) uint8
+    strip = film_strip([f0, f1, f2], ["step 0", "step 500", "step 1000"])
+    save_png(sensor_layout(morphology), "sensors.png"); save_video(frames, "episode.gif")
 
 World y points up (north); screen y points down. ``Renderer.to_screen`` maps world points to
 frame pixels. pygame is imported lazily by ``Renderer`` so importing ``gathering_env`` does not
@@ -788,17 +795,6 @@ class Renderer:
             return _surface_to_array(self._pg, self.draw(sim))
         self._show(sim)
         return None
-
-    def frame(self, sim: GatheringSimulation, **options: Any) -> np.ndarray:
-        """The frame as an array in either render mode (no window involved)."""
-        if options:
-            saved = self._options
-            self.set_options(**options)
-            try:
-                return self.frame(sim)
-            finally:
-                self._configure(saved)
-        return _surface_to_array(self._pg, self.draw(sim))
 
     def _show(self, sim: GatheringSimulation) -> None:
         """``"human"``: show the frame, handle keys; while paused, wait for keys here."""
