@@ -949,7 +949,6 @@ def sensor_layout(morphology: Morphology | Sequence, size_px: int = 480, title: 
     pg.draw.circle(surf, (90, 90, 90), c.tolist(), body)
     pg.draw.circle(surf, ROBOT, c.tolist(), body, 2)
     pg.draw.line(surf, HEADING, c.tolist(), screen(0.0, body * 0.9), 3)
-    text.draw(surf, "heading", int(c[0]) + 4, int(c[1] - body) - text.line - 2, MUTED)
     if any(s.type == "bottom" for s in morphology):
         sq = max(4, int(body * 0.25))
         pg.draw.rect(surf, SENSOR_COLOURS["bottom"], pg.Rect(int(c[0]) - sq, int(c[1]) - sq, 2 * sq, 2 * sq))
@@ -962,6 +961,7 @@ def sensor_layout(morphology: Morphology | Sequence, size_px: int = 480, title: 
         x = size_px + margin
         text.draw(surf, f"{len(morphology)} sensors", x, top)
         text.draw_table(surf, morphology, x, top + text.line + 4, gap)
+        text.draw(surf, "one robot from above, heading up (white line);", x, size_px - margin - 2 * text.line, MUTED)
         text.draw(surf, "cone length proportional to range", x, size_px - margin - text.line, MUTED)
     return _surface_to_array(pg, surf)
 
