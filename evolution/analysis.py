@@ -13,6 +13,12 @@ also the morphology (or more objectives). For every group:
   (the simplest point whose ft is within 10 % of the front's max ft).
 * Statistics: Shapiro-Wilk on every sample, then Student's two-sample t-test (scipy)
   comparing the SO champions with each selection point, for ft and for C (Table 4).
+
+Which ft: with ``reevaluate = K`` > 0 every champion and front genome is re-run K times on
+held-out seeds (``evolution.reevaluate``) and those scores replace the training scores
+(then each run's front is re-filtered to its non-dominated points); with 0 the training
+scores are used, which are biased upward (best-of-many noisy evaluations). C does not
+depend on the seeds. ``Analysis.scores`` says which were used.
 """
 
 from __future__ import annotations
@@ -44,6 +50,8 @@ class Run:
     records: list[dict[str, Any]]
     champion: tuple[float, float] | None        # (ft, C) of the best-ft genome
     front: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # (F, 2) rows (ft, C)
+    champion_training: tuple[float, float] | None = None  # training (ft, C) when re-evaluated
+    front_files: list[str] = field(default_factory=list)   # front/*.json behind each raw front row
 
 
 def load_run(path: Path) -> Run:
@@ -65,14 +73,28 @@ def load_run(path: Path) -> Run:
     if champ_file.exists():
         obj = json.loads(champ_file.read_text())["objectives"]
         champion = (float(obj["task"]), float(obj["morphology"]))
-    points = []
+    points, files = [], []
     for f in sorted((path / "front").glob("*.json")):
         obj = json.loads(f.read_text())["objectives"]
         points.append((float(obj["task"]), float(obj["morphology"])))
-    front = np.array(points, dtype=float).reshape(-1, 2)
-    if len(front):
-        front = front[non_dominated_fronts(front)[0]]
-    return Run(path, experiment.get("name", path.name), env, multi, records, champion, front)
+        files.append(f.relative_to(path).as_posix())
+    return Run(path, experiment.get("name", path.name), env, multi, records, champion,
+               _non_dominated(np.array(points, dtype=float).reshape(-1, 2)), front_files=files)
+
+
+def _non_dominated(points: np.ndarray) -> np.ndarray:
+    return points[non_dominated_fronts(points)[0]] if len(points) else points
+
+
+def apply_reevaluation(run: Run, scores: dict[str, dict[str, Any]]) -> Run:
+    """Replace the training ft of the run's champion and front by held-out ``scores``."""
+    if run.champion is not None and "champion.json" in scores:
+        run.champion_training = run.champion
+        run.champion = (float(scores["champion.json"]["task"]), run.champion[1])
+    if run.front_files:
+        points = [(float(scores[f]["task"]), float(scores[f]["morphology"])) for f in run.front_files]
+        run.front = _non_dominated(np.array(points, dtype=float).reshape(-1, 2))
+    return run
 
 
 def merge_fronts(fronts: list[np.ndarray]) -> np.ndarray:
@@ -148,6 +170,7 @@ def compare(so: np.ndarray, mo: np.ndarray, environment: int, point: str, object
 
 @dataclass
 class Analysis:
+    scores: str                                               # which ft: training or held-out
     runs: list[Run]
     merged_fronts: dict[int, np.ndarray]
     so_points: dict[int, np.ndarray]                         # env -> (R, 2) champions
@@ -156,9 +179,26 @@ class Analysis:
     comparisons: list[Comparison]
 
 
-def analyse(run_dirs: list[Path]) -> Analysis:
-    """Load and compare all runs (see the module docstring)."""
+def analyse(run_dirs: list[Path], reevaluate: int = 0, workers: int | None = None,
+            backend: str = "process") -> Analysis:
+    """Load and compare all runs (see the module docstring).
+
+    Args:
+        run_dirs: run directories. reevaluate: K held-out trials per champion and front
+            genome (0: use the training scores). workers, backend: evaluation backend.
+    """
+    if reevaluate < 0:
+        raise ValueError(f"reevaluate={reevaluate}; allowed: >= 0 (0 = training scores)")
     runs = [load_run(p) for p in run_dirs]
+    if reevaluate:
+        from .reevaluate import reevaluate_run
+
+        for run in runs:
+            apply_reevaluation(run, reevaluate_run(run.path, reevaluate, workers, backend, len(run.records)))
+        scores = (f"held-out: every champion and front genome re-evaluated on {reevaluate} trials with seeds "
+                  "disjoint from training (evolution.reevaluate)")
+    else:
+        scores = "training: the scores recorded during evolution (best-of-many, biased upward)"
     so_by_env: dict[int, list[tuple[float, float]]] = defaultdict(list)
     mo_by_env: dict[int, list[np.ndarray]] = defaultdict(list)
     for run in runs:
@@ -179,7 +219,7 @@ def analyse(run_dirs: list[Path]) -> Analysis:
         for point in SELECTION_POINTS:
             for j, objective in enumerate(("task", "morphology")):
                 comparisons.append(compare(so_points[env][:, j], run_points[env][point][:, j], env, point, objective))
-    return Analysis(runs, merged, so_points, run_points, merged_points, comparisons)
+    return Analysis(scores, runs, merged, so_points, run_points, merged_points, comparisons)
 
 
 def table4_rows(analysis: Analysis) -> list[dict[str, Any]]:

@@ -44,7 +44,8 @@ def genome_to_dict(genome: Any) -> dict[str, Any]:
         "key": genome.key,
         "nodes": {str(k): gene_data(g) for k, g in sorted(genome.nodes.items())},
         "connections": [
-            {"in": k[0], "out": k[1], **gene_data(g)} for k, g in sorted(genome.connections.items())
+            {"in": k[0], "out": k[1], **({"innovation": g.innovation} if hasattr(g, "innovation") else {}),
+             **gene_data(g)} for k, g in sorted(genome.connections.items())
         ],
     }
     sensors = getattr(genome, "sensors", None)
@@ -52,6 +53,36 @@ def genome_to_dict(genome: Any) -> dict[str, Any]:
         items = sensors.items() if isinstance(sensors, dict) else enumerate(sensors)
         out["sensors"] = {str(k): _plain(getattr(s, "to_dict", lambda s=s: vars(s))()) for k, s in items}
     return out
+
+
+def genome_from_dict(data: dict[str, Any], config: Any) -> Any:
+    """Rebuild a genome of ``config.genome_type`` from ``genome_to_dict`` data (for evaluation).
+
+    Raises ``ChampionError`` if the data does not fit the genome class. Connection genes
+    written without an innovation number get their index (innovation numbers only matter
+    for crossover).
+    """
+    gcfg = config.genome_config
+    try:
+        genome = config.genome_type(int(data["key"]))
+        for key, attrs in data["nodes"].items():
+            gene = gcfg.node_gene_type(int(key))
+            for name, value in attrs.items():
+                setattr(gene, name, value)
+            genome.nodes[int(key)] = gene
+        for i, c in enumerate(data["connections"]):
+            key = (int(c["in"]), int(c["out"]))
+            gene = gcfg.connection_gene_type(key, innovation=int(c.get("innovation", i)))
+            for attr in gene._gene_attributes:
+                setattr(gene, attr.name, c[attr.name])
+            genome.connections[key] = gene
+        if "sensors" in data:
+            from .direct import SensorGene
+
+            genome.sensors = {int(k): SensorGene(**v) for k, v in sorted(data["sensors"].items(), key=lambda kv: int(kv[0]))}
+    except (KeyError, TypeError, ValueError, AttributeError) as err:
+        raise ChampionError(f"genome data does not fit {config.genome_type.__name__}: {err!r}") from None
+    return genome
 
 
 def _plain(value: Any) -> Any:

@@ -171,16 +171,33 @@ def analyze_main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("runs", nargs="+", type=Path, help="run directories written by gathering-evolve")
     parser.add_argument("--out", type=Path, default=Path("report"), help="output directory (default: report/)")
+    from .reevaluate import REEVALUATE_TRIALS
+
+    parser.add_argument("--reevaluate", type=int, default=REEVALUATE_TRIALS, metavar="K",
+                        help="re-run every SO champion and MO front genome K times on held-out seeds and report "
+                             f"those scores (default {REEVALUATE_TRIALS}; cached in each run directory); "
+                             "0 = use the training scores")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="evaluation processes for --reevaluate (default: all cores; 1 = serial)")
+    parser.add_argument("--backend", default="process", help="serial, process or ray (default: process)")
     args = parser.parse_args(argv)
     from .analysis import analyse
+    from .backends import BACKENDS
     from .report import write_report
 
+    if args.reevaluate < 0:
+        return _fail(f"--reevaluate={args.reevaluate}; allowed: an integer >= 0 (0 = training scores)")
+    if args.workers is not None and args.workers < 1:
+        return _fail(f"--workers={args.workers}; allowed: >= 1")
+    if args.backend not in BACKENDS:
+        return _fail(f"--backend={args.backend!r}; allowed: {', '.join(BACKENDS)}")
     try:
-        analysis = analyse(args.runs)
+        analysis = analyse(args.runs, reevaluate=args.reevaluate, workers=args.workers, backend=args.backend)
     except ValueError as err:
         return _fail(str(err))
     path = write_report(analysis, args.out)
     print(f"{len(analysis.runs)} runs, {len(analysis.comparisons)} comparisons -> {path}")
+    print(f"ft used: {analysis.scores}")
     return 0
 
 

@@ -1,7 +1,9 @@
 """Evaluate one genome: decode it, run its team for several trials, return its objectives.
 
-The environment is used only through its public API: ``parallel_env(**env_config)``,
-``reset(seed=..., options={"morphology": ...})`` and the dict-free ``step_batch``.
+A genome's trials run as one batch of worlds (``gathering_env.vector.VectorSimulation``):
+every step, the team controller acts once on the readings of all trials' robots, stacked
+``(trials * N, S)``, and one compiled call steps every trial still running. Each trial's
+episode is exactly the one ``parallel_env(**env_config)`` gives for its seed.
 
 Trial seeds are derived from (run seed, generation, trial index) only, so every genome of
 a generation meets the same worlds and a result does not depend on which process ran it.
@@ -15,9 +17,10 @@ from typing import Any
 
 import numpy as np
 
-from gathering_env import SENSOR_TYPES, Morphology, morphological_complexity, parallel_env
+from gathering_env import SENSOR_TYPES, Morphology, morphological_complexity
+from gathering_env.vector import VectorSimulation
 
-_ENV_CACHE: dict[str, Any] = {}
+_SIM_CACHE: dict[str, VectorSimulation] = {}
 
 
 def trial_seed(run_seed: int, generation: int, trial: int) -> int:
@@ -84,34 +87,37 @@ class Evaluation:
         return asdict(self)
 
 
-def _env_for(env_config: dict[str, Any]):
-    key = repr(sorted(env_config.items()))
-    env = _ENV_CACHE.get(key)
-    if env is None:
-        env = parallel_env(**env_config)
-        _ENV_CACHE.clear()  # one live world per process
-        _ENV_CACHE[key] = env
-    return env
+def _worlds_for(env_config: dict[str, Any], trials: int) -> VectorSimulation:
+    """The process's batch of ``trials`` worlds for ``env_config`` (built once, reused)."""
+    key = repr((sorted(env_config.items()), trials))
+    sims = _SIM_CACHE.get(key)
+    if sims is None:
+        sims = VectorSimulation(trials, **env_config)
+        _SIM_CACHE.clear()  # one live batch per process
+        _SIM_CACHE[key] = sims
+    return sims
 
 
-def run_team(env, controller, morphology: Morphology, seed: int) -> tuple[float, int, float, float]:
-    """One episode of a team. Returns (ft, steps, seconds in env, seconds in controller)."""
-    obs_dict, _ = env.reset(seed=seed, options={"morphology": morphology})
-    obs = np.stack([obs_dict[a] for a in env.possible_agents])
+def run_trials(sims: VectorSimulation, controller, morphology: Morphology,
+               seeds: list[int]) -> tuple[np.ndarray, int, float, float]:
+    """One episode per world, all stepped together.
+
+    Returns (ft per world, total steps over the worlds, seconds in the simulation,
+    seconds in the controller)."""
+    obs = sims.reset(seeds, morphology)
+    worlds, robots, width = obs.shape
     t_env = t_ctrl = 0.0
-    steps = 0
     clock = time.perf_counter
     while True:
         t0 = clock()
-        wheels = controller.act(obs)
+        wheels = controller.act(obs.reshape(worlds * robots, width)).reshape(worlds, robots, 2)
         t1 = clock()
-        obs, _, terminated, truncated = env.step_batch(wheels)
+        obs, _, _, _ = sims.step(wheels)
         t_env += clock() - t1
         t_ctrl += t1 - t0
-        steps += 1
-        if terminated or truncated:
+        if not sims.active.any():
             break
-    return float(env.team_info()["task_performance"]), steps, t_env, t_ctrl
+    return sims.task_performance(), int(sims.steps.sum()), t_env, t_ctrl
 
 
 def evaluate(genome: Any, config: Any, env_config: dict[str, Any], trials: int = 5, seed: int = 0,
@@ -130,19 +136,14 @@ def evaluate(genome: Any, config: Any, env_config: dict[str, Any], trials: int =
     t0 = time.perf_counter()
     controller, morphology = decode_genome(method, genome, config, substrate)
     t_decode = time.perf_counter() - t0
-    env = _env_for(env_config)
-    fts, total_steps, t_env, t_ctrl = [], 0, 0.0, 0.0
-    for trial in range(trials):
-        ft, steps, te, tc = run_team(env, controller, morphology, trial_seed(seed, generation, trial))
-        fts.append(ft)
-        total_steps += steps
-        t_env += te
-        t_ctrl += tc
+    sims = _worlds_for(env_config, trials)
+    seeds = [trial_seed(seed, generation, trial) for trial in range(trials)]
+    fts, total_steps, t_env, t_ctrl = run_trials(sims, controller, morphology, seeds)
     return Evaluation(
         task=float(np.mean(fts)),
         morphology=morphological_complexity(morphology),
         controller=100.0 - float(controller.num_links),
-        trial_ft=fts,
+        trial_ft=[float(f) for f in fts],
         sensors=sensor_statistics(morphology),
         steps=total_steps,
         seconds_env=t_env,

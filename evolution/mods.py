@@ -4,10 +4,9 @@
 to ``neat.Config`` and put its parameters in a ``[MODSReproduction]`` section::
 
     [MODSReproduction]
-    species_bound_fraction = 0.5   # at most this fraction of N species survive (SPEC: N/2)
-    tournament_size        = 2     # parent choice within a species, by rank score
-    crossover_rate         = 0.5   # else the child is a mutated copy of one parent
-    progression            = by_front  # or round_robin (the original's plain serial progression)
+    species_bound = per_objective  # at most floor(N / objectives) species (the original);
+                                   # or a fraction f in (0, 1]: floor(f * N) species
+    progression   = round_robin    # the published serial progression; or by_front
 
 neat-python's loop evaluates the population and then calls ``reproduce``. This class keeps
 the previous parents with their objectives, so each call (SPEC section 6):
@@ -18,17 +17,18 @@ the previous parents with their objectives, so each call (SPEC section 6):
    fronts, crowding distance within a front; ties by genome id); each genome gets a rank
    score, descending from the pool size in sort order;
 3. walks the sorted pool and selects each genome's species the first time it appears, up
-   to ``floor(species_bound_fraction * N)`` species;
+   to the species bound;
 4. serial progression: each selected species' members sorted by rank score, one genome
-   per species per round, round after round, until N parents are chosen. With the default
-   ``progression = by_front`` the rounds run front by front (every member of a better front
-   of the selected species is taken before any member of a worse one), which keeps
-   NSGA-II's elitism: no first-front genome of a selected species is lost while the front
-   is smaller than N. ``round_robin`` is the original's plain scan over whole species.
-   (Only if the selected species hold fewer than N genomes altogether are further species
-   admitted, in sort order, so that exactly N parents are always returned);
+   per species per row, row after row, until N parents are chosen (``round_robin``, the
+   paper's and the original's scan). ``by_front`` runs the rows front by front instead
+   (every member of a better front of the selected species before any member of a worse
+   one), which keeps NSGA-II's elitism. (Only if the selected species hold fewer than N
+   genomes altogether are further species admitted, in sort order, so that exactly N
+   parents are always returned);
 5. gives each selected species offspring in proportion to its parents' summed rank scores
-   (largest remainder), bred by tournament on rank score, crossover and mutation.
+   (largest remainder) and breeds them with ``evolution.breeding.breed``, the same routine
+   as the single-objective arm (truncation to the best parents by rank score, one operator
+   per offspring; in crossover the better-ranked parent gives the disjoint genes).
 
 Genomes must carry ``genome.objectives``, a tuple of floats, all maximised (the trainer
 sets it; ``genome.fitness`` stays the task objective for neat-python's reporters). After
@@ -39,7 +39,6 @@ front of the pool: list of (genome id, objectives)) describe the generation.
 from __future__ import annotations
 
 import math
-import random
 from itertools import count
 from typing import Any
 
@@ -47,7 +46,15 @@ import numpy as np
 from neat.config import ConfigParameter, DefaultClassConfig
 from neat.innovation import InnovationTracker
 
+from .breeding import breed
 from .pareto import nsga2_order
+
+PROGRESSIONS = ("round_robin", "by_front")
+REMOVED_KEYS = {
+    "species_bound_fraction": "use species_bound (per_objective, or a fraction in (0, 1])",
+    "tournament_size": "parents are chosen by truncation (the genome section's parent_fraction), as in the SO arm",
+    "crossover_rate": "set crossover_prob in the genome section (shared with the SO arm)",
+}
 
 
 class MODSReproduction(DefaultClassConfig):
@@ -55,24 +62,16 @@ class MODSReproduction(DefaultClassConfig):
 
     @classmethod
     def parse_config(cls, param_dict: dict[str, str]) -> DefaultClassConfig:
+        for key, hint in REMOVED_KEYS.items():
+            if key in param_dict:
+                raise ValueError(f"[MODSReproduction] {key}: no longer used; {hint}")
         config = DefaultClassConfig(param_dict, [
-            ConfigParameter("species_bound_fraction", float, 0.5),
-            ConfigParameter("tournament_size", int, 2),
-            ConfigParameter("crossover_rate", float, 0.5),
-            ConfigParameter("progression", str, "by_front"),
+            ConfigParameter("species_bound", str, "per_objective"),
+            ConfigParameter("progression", str, "round_robin"),
         ], "MODSReproduction")
-        if config.progression not in ("by_front", "round_robin"):
-            raise ValueError(
-                f"[MODSReproduction] progression={config.progression!r}; allowed: 'by_front', 'round_robin'"
-            )
-        if not 0.0 < config.species_bound_fraction <= 1.0:
-            raise ValueError(
-                f"[MODSReproduction] species_bound_fraction={config.species_bound_fraction}; allowed: (0, 1]"
-            )
-        if config.tournament_size < 1:
-            raise ValueError(f"[MODSReproduction] tournament_size={config.tournament_size}; allowed: >= 1")
-        if not 0.0 <= config.crossover_rate <= 1.0:
-            raise ValueError(f"[MODSReproduction] crossover_rate={config.crossover_rate}; allowed: [0, 1]")
+        if config.progression not in PROGRESSIONS:
+            raise ValueError(f"[MODSReproduction] progression={config.progression!r}; allowed: {list(PROGRESSIONS)}")
+        species_bound_value(config.species_bound, 2, 1)  # validates
         return config
 
     def __init__(self, config: DefaultClassConfig, reporters: Any, stagnation: Any) -> None:
@@ -119,7 +118,7 @@ class MODSReproduction(DefaultClassConfig):
         score = {k: float(len(keys) - pos) for pos, k in enumerate(ranked)}
         self.front = [(keys[i], tuple(objectives[i])) for i in order if front_of[i] == 0]
 
-        bound = max(1, math.floor(self.reproduction_config.species_bound_fraction * n))
+        bound = species_bound_value(self.reproduction_config.species_bound, n, objectives.shape[1])
         selected: list[int] = []
         for k in ranked:
             sid = species_of[k]
@@ -200,27 +199,24 @@ class MODSReproduction(DefaultClassConfig):
                 species.species[sid].members = {k: pool[k] for k in by_species[sid]}
 
         new_population: dict[int, Any] = {}
-        cfg = self.reproduction_config
         for sid, ks in by_species.items():
-            for _ in range(counts[sid]):
-                p1 = self._tournament(ks, score, cfg.tournament_size)
-                gid = next(self.genome_indexer)
-                child = config.genome_type(gid)
-                if random.random() < cfg.crossover_rate:
-                    p2 = self._tournament(ks, score, cfg.tournament_size)
-                    child.configure_crossover(pool[p1], pool[p2], config.genome_config)
-                    self.ancestors[gid] = (p1, p2)
-                else:
-                    child.configure_crossover(pool[p1], pool[p1], config.genome_config)
-                    self.ancestors[gid] = (p1,)
-                child.mutate(config.genome_config)
-                new_population[gid] = child
+            ranked = sorted(ks, key=lambda k: -score[k])  # best first
+            new_population.update(breed(ranked, pool, score, counts[sid], config, lambda: next(self.genome_indexer),
+                                        self.ancestors))
         return new_population
 
-    @staticmethod
-    def _tournament(candidates: list[int], score: dict[int, float], size: int) -> int:
-        picks = [random.choice(candidates) for _ in range(size)]
-        return max(picks, key=lambda k: (score[k], -k))
+
+def species_bound_value(setting: str, n: int, num_objectives: int) -> int:
+    """The species bound for N parents: floor(N / objectives) or floor(fraction * N), at least 1."""
+    if setting == "per_objective":
+        return max(1, n // num_objectives)
+    try:
+        fraction = float(setting)
+    except ValueError:
+        fraction = float("nan")
+    if not 0.0 < fraction <= 1.0:
+        raise ValueError(f"[MODSReproduction] species_bound={setting!r}; allowed: 'per_objective' or a fraction in (0, 1]")
+    return max(1, math.floor(fraction * n))
 
 
 def _objectives(genome: Any) -> tuple[float, ...]:

@@ -66,7 +66,7 @@ def figure4(analysis: Analysis, out: Path) -> Path:
         ax.scatter([], [], marker=marker, facecolors="none", edgecolors="k", label=point)
     ax.set_xlabel("morphological simplicity C (eq. 2)")
     ax.set_ylabel("task performance ft (eq. 1)")
-    ax.set_title("Figure 4: MO fronts vs SO champions")
+    ax.set_title(f"Figure 4: MO fronts vs SO champions ({analysis.scores.split(':')[0]} ft)")
     ax.legend(fontsize=7, loc="best")
     path = out / "figure4_fronts.png"
     fig.savefig(path, dpi=110)
@@ -110,7 +110,7 @@ def figure6(analysis: Analysis, out: Path) -> Path:
         ax.bar(x + i * width, means, width, yerr=errs, capsize=3, color=ENV_COLOURS.get(env, "k"), label=f"env {env}")
     ax.set_xticks(x + width * (len(envs) - 1) / 2, SELECTION_POINTS)
     ax.set_ylabel("morphological simplicity C")
-    ax.set_title("Figure 6: simplicity per selection point")
+    ax.set_title(f"Figure 6: simplicity per selection point ({analysis.scores.split(':')[0]} ft)")
     ax.legend(fontsize=7)
     path = out / "figure6_points.png"
     fig.savefig(path, dpi=110)
@@ -124,13 +124,17 @@ def write_report(analysis: Analysis, out: Path) -> Path:
     table_md, table_csv = write_table4(analysis, out)
     figs = [figure4(analysis, out), figure5(analysis, out), figure6(analysis, out)]
     lines = ["# Cost on morphological complexity: analysis report", "",
-             f"Runs analysed: {len(analysis.runs)}", ""]
-    lines.append("| run | kind | env | generations | champion ft | champion C | front size |")
-    lines.append("|---|---|---|---|---|---|---|")
+             f"Runs analysed: {len(analysis.runs)}", "",
+             f"Task performance ft in the table, figures 4 and 6 and the run list: {analysis.scores}. "
+             "Figure 5 shows population means recorded during training.", ""]
+    lines.append("| run | kind | env | generations | champion ft | champion ft (training) | champion C | front size |")
+    lines.append("|---|---|---|---|---|---|---|---|")
     for r in analysis.runs:
         ft, c = r.champion if r.champion else (float("nan"), float("nan"))
+        trained = f"{r.champion_training[0]:.2f}" if r.champion_training else ""
         lines.append(f"| {r.path.name} | {'MO' if r.multi_objective else 'SO'} | {r.environment} | "
-                     f"{len(r.records)} | {ft:.2f} | {c:.1f} | {len(r.front) if r.multi_objective else ''} |")
+                     f"{len(r.records)} | {ft:.2f} | {trained} | {c:.1f} | "
+                     f"{len(r.front) if r.multi_objective else ''} |")
     lines += ["", "## Selection points of the merged MO fronts (ft, C)", ""]
     for env, pts in sorted(analysis.merged_points.items()):
         cells = ", ".join(f"{p} = ({v[0]:.2f}, {v[1]:.1f})" for p, v in pts.items())

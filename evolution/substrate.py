@@ -14,7 +14,8 @@ target); every output is clipped to [-1, 1]. Decoding:
 * a link exists when |w| > ``weight_threshold`` (0.2); its weight is
   ``sign(w) (|w| - 0.2) * max_weight / (1 - 0.2)`` (max_weight = 5);
 * a node's bias is the bias-weight output queried at (0, 0, x_target, y_target), times
-  ``max_weight`` (not thresholded);
+  ``max_weight`` (SPEC: not thresholded); with ``bias_threshold`` (the original's choice)
+  it goes through the same threshold and rescaling as a link weight, so |b| <= 0.2 gives 0;
 * each input node's **sensor** comes from its outgoing link with the highest *signed* CPPN
   weight: type from the ``type`` output split into ``len(sensor_types)`` equal bands over
   [-1, 1] (infrared, ultrasonic, colour, camera); fov and range mapped linearly from
@@ -63,6 +64,7 @@ class Substrate:
     range_floor: float = 0.001
     output_activation: str = "steep_sigmoid"
     hidden_activation: str = "tanh"
+    bias_threshold: bool = False
 
     def __post_init__(self) -> None:
         if not 1 <= self.num_inputs <= 10:
@@ -144,7 +146,8 @@ def decode(genome: Any, config: Any, substrate: Substrate | None = None) -> tupl
     w_in = sub.scale_weight(q_in[:, :, W])                               # (I, T)
     q_hid = np.array([[query(net, h, o) for o in outputs] for h in hidden]).reshape(len(hidden), 2, 6)
     w_hid = sub.scale_weight(q_hid[:, :, W]) if len(hidden) else np.zeros((0, 2))
-    bias = np.array([query(net, origin, t)[BIAS] for t in targets]) * sub.max_weight
+    bias_out = np.array([query(net, origin, t)[BIAS] for t in targets])
+    bias = sub.scale_weight(bias_out) if sub.bias_threshold else bias_out * sub.max_weight
 
     sensors: list[SensorSpec] = []
     used: list[int] = []

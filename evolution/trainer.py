@@ -58,8 +58,10 @@ def genome_class(method: str) -> type:
 def make_neat_config(experiment: Experiment) -> neat.Config:
     """Load the experiment's neat-python config; the population size comes from the experiment.
 
-    Single-objective runs use neat-python's ``DefaultReproduction``; multi-objective runs
-    use ``MODSReproduction`` (its ``[MODSReproduction]`` section in the same file).
+    Single-objective runs use ``NEATReproduction`` (neat-python's ``DefaultReproduction``
+    selection, its ``[NEATReproduction]`` section); multi-objective runs use
+    ``MODSReproduction`` (its ``[MODSReproduction]`` section in the same file). Both breed
+    with ``evolution.breeding.breed``.
     """
     path = experiment.neat_config
     if experiment.multi_objective:
@@ -67,7 +69,9 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
 
         reproduction: type = MODSReproduction
     else:
-        reproduction = neat.DefaultReproduction
+        from .breeding import NEATReproduction
+
+        reproduction = NEATReproduction
     try:
         config = neat.Config(genome_class(experiment.method), reproduction,
                              neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))

@@ -24,6 +24,9 @@ ENVIRONMENT_PRESETS: dict[int, tuple[int, int, int]] = {
     3: (0, 5, 10),  # high cooperation
 }
 
+#: Implementations of the step (``WorldConfig.kernel``).
+KERNELS: tuple[str, str] = ("compiled", "numpy")
+
 #: Names of the three block types, index = type id.
 BLOCK_TYPE_NAMES: tuple[str, str, str] = ("small", "medium", "large")
 
@@ -107,6 +110,12 @@ class WorldConfig:
     """Bonus for gathering every block, scaled by the unused fraction of steps (paper: 20,
     original code: 10)."""
 
+    # --- implementation ----------------------------------------------------------------
+    kernel: str = "compiled"
+    """Which implementation computes everything of a step but pymunk's physics: 'compiled'
+    (numba kernels, ``gathering_env.kernels``) or 'numpy' (the vectorised reference).
+    Both give the same episodes; see docs/performance.md."""
+
     environment: int | None = field(default=2, compare=False)
     """Preset the block counts came from (informational; None if counts were overridden)."""
 
@@ -175,6 +184,8 @@ class WorldConfig:
                 raise ValueError(f"{name}={value!r} must be a bool (True or False)")
         if self.ir_response not in ("linear", "gamma"):
             raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma'")
+        if self.kernel not in KERNELS:
+            raise ValueError(f"kernel={self.kernel!r}; allowed: {', '.join(map(repr, KERNELS))}")
         if sum(self.block_counts) == 0:
             raise ValueError("block_counts=(0, 0, 0): the world needs at least one block")
 

@@ -135,6 +135,8 @@ class GatheringEnv(ParallelEnv):
             raise RuntimeError(
                 "step() called after the episode ended (or before reset()); call reset() first"
             )
+        if not isinstance(actions, dict):
+            raise TypeError(f"actions must be a dict {{agent: (left, right)}}; got {type(actions).__name__}")
         if actions.keys() != self._agent_index.keys():
             self._explain_action_keys(actions)
         try:
@@ -156,7 +158,7 @@ class GatheringEnv(ParallelEnv):
         terminations = dict.fromkeys(agents, terminated)
         truncations = dict.fromkeys(agents, truncated)
         info = self._team_info()
-        infos = {a: dict(info) for a in agents}
+        infos = {a: info.copy() for a in agents}
         if terminated or truncated:
             self.agents = []
         if self.render_mode == "human":

@@ -72,7 +72,9 @@ def attached_wheels(world: GatheringWorld, robots: np.ndarray) -> np.ndarray:
     cfg = world.config
     cx, cy = cfg.zone_centre
     pos = world.robot_pos[robots]
-    bearing = np.arctan2(cy - pos[:, 1], cx - pos[:, 0])
+    # libm's atan2 (as the compiled kernel uses), not numpy's own SIMD arctan2, which differs
+    # from it in the last bit: both kernels must steer identically.
+    bearing = np.array([math.atan2(cy - y, cx - x) for x, y in pos.tolist()])
     error = _wrap(bearing - world.robot_angle[robots])
     backwards = np.abs(error) > 0.5 * math.pi
     direction = np.where(backwards, -1.0, 1.0)

@@ -102,18 +102,19 @@ class SensorBank:
 
     # ------------------------------------------------------------------------------
     def read(self, robot_pos: np.ndarray, robot_angle: np.ndarray,
-             block_pos: np.ndarray, block_angle: np.ndarray) -> np.ndarray:
+             block_pos: np.ndarray, block_angle: np.ndarray, dtype=np.float32) -> np.ndarray:
         """Observation matrix for the team.
 
         Args:
             robot_pos: (N, 2) robot centres. robot_angle: (N,) headings (rad).
             block_pos: (B, 2) block centres. block_angle: (B,) block rotations (rad).
+            dtype: of the result: float32 (the env's observations) or float64.
 
         Returns:
-            (N, S) float32 readings in [0, 1], columns in morphology order.
+            (N, S) readings in [0, 1], columns in morphology order.
         """
         n = robot_pos.shape[0]
-        out = np.zeros((n, self.num_sensors), dtype=np.float32)
+        out = np.zeros((n, self.num_sensors), dtype=dtype)
         if self._has_cone:
             out[:, self._cone_idx] = self._read_cones(robot_pos, robot_angle, block_pos, block_angle)
         if self._bottom_idx.size:
@@ -215,11 +216,24 @@ class SensorBank:
         heading = np.stack((hx, hy), axis=-1)                            # (N, C, 2)
         cos_d = heading @ _WALL_NORMALS.T                                 # (N, C, 4)
         sin_d = np.abs(heading @ _WALL_TANGENTS.T)
-        perp = self._wall_offset - np.stack((mx, my), axis=-1) @ _WALL_NORMALS.T
+        # A robot may overlap a wall for a step (contacts are discrete): its mount then lies
+        # outside the arena, which reads as touching the wall (distance 0), never closer.
+        perp = np.maximum(self._wall_offset - np.stack((mx, my), axis=-1) @ _WALL_NORMALS.T, 0.0)
         cos_eff = np.where(cos_d >= self._cos_half_w, 1.0, cos_d * self._cos_half_w + sin_d * self._sin_half_w)
         with np.errstate(divide="ignore", invalid="ignore"):
             dist = np.where(cos_eff > 1e-9, perp / cos_eff, np.inf)
         return dist.min(axis=-1)
 
 
-__all__ = ["SensorBank", "IR", "US", "COLOUR", "CAMERA", "BOTTOM"]
+def sensor_bank(morphology: Morphology, config: WorldConfig, block_half_sizes: np.ndarray,
+                block_needs: np.ndarray):
+    """The sensing of ``config.kernel``: this module's ``SensorBank`` ('numpy') or
+    ``kernels.CompiledSensorBank`` ('compiled'); both have ``read(...)`` as above."""
+    if config.kernel == "compiled":
+        from .kernels import CompiledSensorBank
+
+        return CompiledSensorBank(morphology, config, block_half_sizes, block_needs)
+    return SensorBank(morphology, config, block_half_sizes, block_needs)
+
+
+__all__ = ["SensorBank", "sensor_bank", "IR", "US", "COLOUR", "CAMERA", "BOTTOM"]

@@ -10,6 +10,15 @@ trainers that drive the whole team at once:
 Step order (SPEC section 2): the controller's wheel commands (computed from the previous
 observation) -> heuristics override them (collision avoidance, attached robots) -> drive
 -> physics step -> pickup -> scoring -> sensing of the new state.
+
+Two kernels compute the same step, chosen by ``WorldConfig.kernel``:
+
+* ``"compiled"`` (default): ``CompiledSimulation``, numba kernels around pymunk
+  (``gathering_env.engine``; one world of the batched engine).
+* ``"numpy"``: ``NumpySimulation``, the vectorised numpy reference (``sensing``,
+  ``heuristics``, ``scoring``) that the tests compare the compiled kernels against.
+
+``GatheringSimulation(config)`` returns the one the config names.
 """
 
 from __future__ import annotations
@@ -17,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .config import WorldConfig
+from .engine import CompiledWorlds
 from .heuristics import attached_wheels, avoidance_turns, pickup_candidates
 from .scoring import gathered_mask, task_performance
 from .sensing import SensorBank
@@ -27,39 +37,37 @@ from .world import GatheringWorld
 class GatheringSimulation:
     """The task's state machine over a ``GatheringWorld``.
 
+    ``GatheringSimulation(config, morphology=None)`` builds the subclass of
+    ``config.kernel``; both have the same interface and give the same episodes.
+
     Attributes (after ``reset``):
-        world: the pymunk world. bank: the sensing kernel of the current morphology.
-        steps: steps taken. gathered: (B,) bool blocks wholly inside the zone.
+        world: the pymunk world. steps: steps taken. done: the episode has ended.
+        gathered: (B,) bool blocks wholly inside the zone.
         gathered_value: sum of the values of gathered blocks (v_c).
     """
+
+    def __new__(cls, config: WorldConfig | None = None, morphology: Morphology | None = None):
+        if cls is GatheringSimulation and config is not None:
+            cls = CompiledSimulation if config.kernel == "compiled" else NumpySimulation
+        return super().__new__(cls)
 
     def __init__(self, config: WorldConfig, morphology: Morphology | None = None) -> None:
         self.config = config
         self.morphology = morphology if morphology is not None else Morphology.khepera_iii()
-        self.world = GatheringWorld(config)
         self.total_value = config.total_value
-        self.steps = 0
-        self.done = True
+
+    @staticmethod
+    def _generator(seed: int | np.random.Generator | None) -> np.random.Generator:
+        return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
 
     def reset(self, seed: int | np.random.Generator | None = None,
               morphology: Morphology | None = None) -> np.ndarray:
         """Start a new episode; returns the first observation (N, S) float32."""
-        if morphology is not None:
-            self.morphology = morphology
-        rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-        self.world.reset(rng)
-        w = self.world
-        self.bank = SensorBank(self.morphology, self.config, w.block_half, w.block_need)
-        self.steps = 0
-        self.done = False
-        self.gathered = gathered_mask(w.block_pos, w.block_angle, w.block_half, self.config.zone_rect)
-        self.gathered_value = float(self.world.block_value[self.gathered].sum())
-        return self.observe()
+        raise NotImplementedError
 
     def observe(self) -> np.ndarray:
         """Current readings of every robot's sensors, (N, S) float32 in [0, 1]."""
-        w = self.world
-        return self.bank.read(w.robot_pos, w.robot_angle, w.block_pos, w.block_angle)
+        raise NotImplementedError
 
     def step(self, wheels: np.ndarray) -> tuple[np.ndarray, float, bool, bool]:
         """Advance one step.
@@ -74,6 +82,52 @@ class GatheringSimulation:
             ``100 * (change in gathered value) / total value``, so an episode's rewards sum
             to the value part of eq. 1.
         """
+        raise NotImplementedError
+
+    # ------------------------------------------------------------------ statistics
+    def blocks_gathered_by_type(self) -> tuple[int, int, int]:
+        """Gathered blocks per type (small, medium, large)."""
+        key = self.gathered.tobytes()
+        cached = self.__dict__.get("_by_type")
+        if cached is None or cached[0] != key or cached[1] is not self.world.block_type:
+            counts = np.bincount(self.world.block_type[self.gathered], minlength=3)
+            cached = (key, self.world.block_type, (int(counts[0]), int(counts[1]), int(counts[2])))
+            self._by_type = cached
+        return cached[2]
+
+    def task_performance(self) -> float:
+        """Paper eq. 1 for the episode so far (final once the episode has ended)."""
+        return task_performance(self.gathered_value, self.total_value, self.steps,
+                                self.config.max_cycles, self.config.time_bonus)
+
+
+class NumpySimulation(GatheringSimulation):
+    """The numpy reference kernel (``kernel="numpy"``). ``bank``: its ``SensorBank``."""
+
+    def __init__(self, config: WorldConfig, morphology: Morphology | None = None) -> None:
+        super().__init__(config, morphology)
+        self.world = GatheringWorld(config)
+        self.steps = 0
+        self.done = True
+
+    def reset(self, seed: int | np.random.Generator | None = None,
+              morphology: Morphology | None = None) -> np.ndarray:
+        if morphology is not None:
+            self.morphology = morphology
+        self.world.reset(self._generator(seed))
+        w = self.world
+        self.bank = SensorBank(self.morphology, self.config, w.block_half, w.block_need)
+        self.steps = 0
+        self.done = False
+        self.gathered = gathered_mask(w.block_pos, w.block_angle, w.block_half, self.config.zone_rect)
+        self.gathered_value = float(self.world.block_value[self.gathered].sum())
+        return self.observe()
+
+    def observe(self) -> np.ndarray:
+        w = self.world
+        return self.bank.read(w.robot_pos, w.robot_angle, w.block_pos, w.block_angle)
+
+    def step(self, wheels: np.ndarray) -> tuple[np.ndarray, float, bool, bool]:
         if self.done:
             raise RuntimeError("step() called after the episode ended; call reset() first")
         cfg, w = self.config, self.world
@@ -105,16 +159,51 @@ class GatheringSimulation:
         self.done = terminated or truncated
         return self.observe(), reward, terminated, truncated
 
-    # ------------------------------------------------------------------ statistics
-    def blocks_gathered_by_type(self) -> tuple[int, int, int]:
-        """Gathered blocks per type (small, medium, large)."""
-        counts = np.bincount(self.world.block_type[self.gathered], minlength=3)
-        return (int(counts[0]), int(counts[1]), int(counts[2]))
 
-    def task_performance(self) -> float:
-        """Paper eq. 1 for the episode so far (final once the episode has ended)."""
-        return task_performance(self.gathered_value, self.total_value, self.steps,
-                                self.config.max_cycles, self.config.time_bonus)
+class CompiledSimulation(GatheringSimulation):
+    """The compiled kernel (``kernel="compiled"``): one world of ``CompiledWorlds``."""
+
+    def __init__(self, config: WorldConfig, morphology: Morphology | None = None) -> None:
+        super().__init__(config, morphology)
+        self.engine = CompiledWorlds(config, 1)
+        self.world = self.engine.worlds[0]
+        self._started = False
+
+    def reset(self, seed: int | np.random.Generator | None = None,
+              morphology: Morphology | None = None) -> np.ndarray:
+        if morphology is not None:
+            self.morphology = morphology
+        self.engine.reset([self._generator(seed)], self.morphology)
+        self._started = True
+        return self.engine.obs[0].copy()
+
+    def observe(self) -> np.ndarray:
+        self.engine.sense(np.ones(1, dtype=np.bool_))
+        return self.engine.obs[0].copy()
+
+    def step(self, wheels: np.ndarray) -> tuple[np.ndarray, float, bool, bool]:
+        engine = self.engine
+        if not engine.active[0]:
+            raise RuntimeError("step() called after the episode ended; call reset() first")
+        engine.step(np.asarray(wheels, dtype=np.float64).reshape(1, -1, 2))
+        return (engine.obs[0].copy(), float(engine.reward[0]), bool(engine.terminated[0]),
+                bool(engine.truncated[0]))
+
+    @property
+    def steps(self) -> int:
+        return int(self.engine.steps[0]) if self._started else 0
+
+    @property
+    def done(self) -> bool:
+        return not self._started or not bool(self.engine.active[0])
+
+    @property
+    def gathered(self) -> np.ndarray:
+        return self.engine.gathered[0]
+
+    @property
+    def gathered_value(self) -> float:
+        return float(self.engine.gathered_value[0])
 
 
 def check_wheels(wheels: np.ndarray, num_robots: int) -> np.ndarray:

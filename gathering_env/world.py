@@ -12,9 +12,11 @@ body's velocity with at most ``robot_drive_force`` / ``robot_drive_torque``. The
 velocity is the differential-drive velocity along the robot's heading, so the robot has
 no side-slip, brakes when its wheels stop, and can push with at most its drive force.
 
-State is exchanged with pymunk in bulk through ``pymunk.batch`` (one call to read all
-poses, one to set all control velocities); the rest of the package works on the numpy
-arrays ``robot_pos``, ``robot_angle``, ``block_pos`` and ``block_angle``.
+State is exchanged with pymunk in bulk through ``pymunk.batch`` (one call to read every
+body's pose and velocity, one to set all velocities); the rest of the package works on the
+numpy arrays ``robot_pos``, ``robot_angle``, ``block_pos`` and ``block_angle``. These arrays
+are updated in place, so a batch of worlds (``gathering_env.engine``) can own them as views
+of its own (W, ...) arrays (``adopt``).
 """
 
 from __future__ import annotations
@@ -27,8 +29,12 @@ import pymunk.batch as pbatch
 
 from .config import WorldConfig
 
-_POSE = pbatch.BodyFields.POSITION | pbatch.BodyFields.ANGLE
 _VEL = pbatch.BodyFields.VELOCITY | pbatch.BodyFields.ANGULAR_VELOCITY
+_STATE = pbatch.BodyFields.POSITION | pbatch.BodyFields.ANGLE | _VEL
+"""What ``fetch_raw`` reads: per body x, y, angle, vx, vy, angular velocity."""
+STATE_ARRAYS = ("robot_pos", "robot_angle", "block_pos", "block_angle", "robot_attached",
+                "block_sticky_side", "anchor_owner", "raw")
+"""The per-world arrays a batch may own (see ``adopt``)."""
 _WALL_RADIUS = 0.5
 
 # Block sides in the block frame: outward normal and tangent of side 0..3 (E, N, W, S).
@@ -125,11 +131,29 @@ class GatheringWorld:
 
         self._index_bodies()
         n, b = cfg.num_robots, len(types)
+        self.robot_pos = np.zeros((n, 2))
+        self.robot_angle = np.zeros(n)
+        self.block_pos = np.zeros((b, 2))
+        self.block_angle = np.zeros(b)
+        self.raw = np.zeros((self._num_rows, 6))
         self.robot_attached = np.full(n, -1, dtype=np.int64)
         self.block_sticky_side = np.full(b, -1, dtype=np.int64)
-        self.anchor_owner = np.full((b, int(self.block_need.max(initial=1))), -1, dtype=np.int64)
+        self.anchor_owner = np.full((b, self.anchor_slots), -1, dtype=np.int64)
         self._welds: dict[int, tuple[pymunk.Constraint, pymunk.Constraint]] = {}
         self.read_state()
+
+    @property
+    def anchor_slots(self) -> int:
+        """Columns of ``anchor_owner``: the most robots any block needs."""
+        return int(np.max(self.config.robots_needed))
+
+    def adopt(self, arrays: dict[str, np.ndarray]) -> None:
+        """Keep the state in the given arrays (same shapes and dtypes as ``STATE_ARRAYS``),
+        copying the current values into them; from now on they are updated in place."""
+        for name in STATE_ARRAYS:
+            target = arrays[name]
+            target[...] = getattr(self, name)
+            setattr(self, name, target)
 
     def _add_walls(self) -> None:
         cfg, r = self.config, _WALL_RADIUS
@@ -196,18 +220,30 @@ class GatheringWorld:
         self._set_buf = pbatch.Buffer()
 
     # ------------------------------------------------------------------ stepping
-    def read_state(self) -> None:
-        """Refresh ``robot_pos/angle`` and ``block_pos/angle`` from pymunk (one batch call)."""
+    def fetch_raw(self) -> None:
+        """Copy every body's pose and velocity from pymunk into ``raw`` (one batch call)."""
         buf = self._buf
         buf.clear()
-        pbatch.get_space_bodies(self.space, _POSE, buf)
-        poses = np.frombuffer(buf.float_buf(), dtype=np.float64).reshape(self._num_rows, 3)
-        robots = poses[self._robot_rows]
-        blocks = poses[self._block_rows]
-        self.robot_pos = robots[:, :2]
-        self.robot_angle = robots[:, 2]
-        self.block_pos = blocks[:, :2]
-        self.block_angle = blocks[:, 2]
+        pbatch.get_space_bodies(self.space, _STATE, buf)
+        self.raw[...] = np.frombuffer(buf.float_buf(), dtype=np.float64).reshape(self._num_rows, 6)
+
+    def read_state(self) -> None:
+        """Refresh ``raw``, ``robot_pos/angle`` and ``block_pos/angle`` from pymunk."""
+        self.fetch_raw()
+        robots = self.raw[self._robot_rows]
+        blocks = self.raw[self._block_rows]
+        self.robot_pos[...] = robots[:, :2]
+        self.robot_angle[...] = robots[:, 2]
+        self.block_pos[...] = blocks[:, :2]
+        self.block_angle[...] = blocks[:, 2]
+
+    def set_velocities(self, vel: np.ndarray) -> None:
+        """Set every body's velocity from ``vel`` (rows, 3) in pymunk's body order. The array
+        is read in place (no copy) and stays registered: later calls with the same array
+        only repeat the pymunk call."""
+        if self._set_buf._float_buf is not vel:
+            self._set_buf.set_float_buf(vel)
+        pbatch.set_space_bodies(self.space, _VEL, self._set_buf)
 
     def apply_drive(self, wheels: np.ndarray) -> None:
         """Set each robot's wheel drive for the next physics step.
@@ -220,17 +256,13 @@ class GatheringWorld:
         v_right = wheels[:, 1] * cfg.robot_max_speed
         forward = 0.5 * (v_left + v_right)
         spin = (v_right - v_left) / (2.0 * cfg.robot_radius)
-        buf = self._buf
-        buf.clear()
-        pbatch.get_space_bodies(self.space, _VEL, buf)
-        vel = np.frombuffer(buf.float_buf(), dtype=np.float64).reshape(self._num_rows, 3).copy()
+        vel = self.raw[:, 3:6].copy()   # every body's velocity as last read
         rows = self._control_rows
         heading = self.robot_angle + 0.5 * cfg.dt * spin  # mid-step heading: arcs, not polygons
         vel[rows, 0] = forward * np.cos(heading)
         vel[rows, 1] = forward * np.sin(heading)
         vel[rows, 2] = spin
-        self._set_buf.set_float_buf(vel.tobytes())
-        pbatch.set_space_bodies(self.space, _VEL, self._set_buf)
+        self.set_velocities(vel)
 
     def step_physics(self) -> None:
         """Advance pymunk by ``dt`` (in ``physics_substeps`` equal sub-steps) and refresh the arrays.
@@ -298,10 +330,23 @@ class GatheringWorld:
                     best = (dist, side, slot, point)
         if best is None or best[0] > cfg.pickup_reach * cfg.robot_radius:
             return False
-        _, side, slot, point = best
+        _, side, slot, _ = best
+        self.block_sticky_side[block] = side
+        self.anchor_owner[block, slot] = robot
+        self.robot_attached[robot] = block
+        self.weld(robot, block, slot, front)
+        return True
+
+    def weld(self, robot: int, block: int, slot: int, front: np.ndarray) -> None:
+        """The pymunk side of an attachment already recorded in the arrays (``robot`` owns
+        anchor ``slot`` of the block's sticky side): weld the robot to the block at its front
+        point, or, with ``pickup_positioning``, first snap it onto the anchor facing the block."""
+        cfg = self.config
         robot_body = self.robot_bodies[robot]
         block_body = self.block_bodies[block]
         if cfg.pickup_positioning:
+            side = int(self.block_sticky_side[block])
+            point = self.anchor_points(block, side)[slot]
             normal_angle = self.block_angle[block] + math.atan2(*_SIDE_NORMALS[side][::-1])
             outward = np.array([math.cos(normal_angle), math.sin(normal_angle)])
             robot_body.position = tuple(point + outward * cfg.robot_radius)
@@ -311,24 +356,24 @@ class GatheringWorld:
             self.space.reindex_shapes_for_body(robot_body)
             weld_point = tuple(point)
         else:
-            weld_point = tuple(front)
+            weld_point = (float(front[0]), float(front[1]))
         pivot = pymunk.PivotJoint(robot_body, block_body, weld_point)
         pivot.collide_bodies = False
         gear = pymunk.GearJoint(robot_body, block_body, block_body.angle - robot_body.angle, 1.0)
         gear.collide_bodies = False
         self.space.add(pivot, gear)
         self._welds[robot] = (pivot, gear)
-        self.block_sticky_side[block] = side
-        self.anchor_owner[block, slot] = robot
-        self.robot_attached[robot] = block
         if cfg.pickup_positioning:
             self.read_state()
-        return True
+
+    def unweld(self, robot: int) -> None:
+        """Remove the pymunk weld of ``robot`` (the arrays are the caller's business)."""
+        self.space.remove(*self._welds.pop(int(robot)))
 
     def detach_block(self, block: int) -> None:
         """Release every robot welded to ``block`` and clear its sticky side."""
         for robot in np.flatnonzero(self.robot_attached == block):
-            self.space.remove(*self._welds.pop(int(robot)))
+            self.unweld(int(robot))
             self.robot_attached[robot] = -1
         self.anchor_owner[block] = -1
         self.block_sticky_side[block] = -1

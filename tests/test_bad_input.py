@@ -9,6 +9,8 @@ import pytest
 
 from gathering_env import Morphology, SensorSpec, parallel_env
 
+pytestmark = pytest.mark.usefixtures("both_kernels")  # the same checks and messages on both kernels
+
 
 @pytest.mark.parametrize("kwargs,needle", [
     (dict(type="laser", range=1, fov=1), "type='laser'"),

@@ -10,6 +10,7 @@ import neat
 import numpy as np
 import pytest
 
+from evolution.breeding import NEATReproduction
 from evolution.controller import TeamController
 from evolution.direct import NEATMGenome, decode_neat_m
 
@@ -55,7 +56,7 @@ def test_round_trip_through_dict():
 
 def test_neat_m_network_matches_neat_feed_forward_per_robot():
     """A NEAT-M genome with hidden nodes: our layered batch vs neat-python's own network."""
-    config = neat.Config(NEATMGenome, neat.DefaultReproduction, neat.DefaultSpeciesSet,
+    config = neat.Config(NEATMGenome, NEATReproduction, neat.DefaultSpeciesSet,
                          neat.DefaultStagnation, str(CFG))
     population = neat.Population(config, seed=4)
     random.seed(4)

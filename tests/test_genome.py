@@ -9,6 +9,7 @@ from pathlib import Path
 import neat
 import pytest
 
+from evolution.breeding import NEATReproduction
 from evolution.direct import NEATMGenome, SensorGene, decode_neat_m
 from evolution.genome import CPPNGenome
 from evolution.substrate import decode
@@ -18,7 +19,7 @@ CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 
 
 def load(genome_type, name):
-    return neat.Config(genome_type, neat.DefaultReproduction, neat.DefaultSpeciesSet,
+    return neat.Config(genome_type, NEATReproduction, neat.DefaultSpeciesSet,
                        neat.DefaultStagnation, str(CONFIGS / name))
 
 
@@ -105,7 +106,7 @@ def test_unknown_genome_key_is_an_error(tmp_path):
     path = tmp_path / "bad.cfg"
     path.write_text(text)
     with pytest.raises(ValueError, match="num_hiden"):
-        neat.Config(CPPNGenome, neat.DefaultReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
+        neat.Config(CPPNGenome, NEATReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
 
 
 def test_cppn_needs_six_outputs(tmp_path):
@@ -114,4 +115,4 @@ def test_cppn_needs_six_outputs(tmp_path):
     path = tmp_path / "bad.cfg"
     path.write_text(text)
     with pytest.raises(ValueError, match="num_outputs=5"):
-        neat.Config(CPPNGenome, neat.DefaultReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
+        neat.Config(CPPNGenome, NEATReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))

@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from evolution.breeding import BreedingGenome
 from evolution.mods import MODSReproduction
 from evolution.pareto import non_dominated_fronts
 
@@ -22,7 +23,11 @@ pop_size              = {pop}
 reset_on_extinction   = False
 no_fitness_termination = True
 
-[DefaultGenome]
+[BreedingGenome]
+variation = one_operator
+parent_fraction = 0.3
+crossover_prob = 0.5
+weight_mutate_prob = 0.5
 num_inputs = 2
 num_outputs = 1
 num_hidden = 0
@@ -80,16 +85,15 @@ max_stagnation = 15
 species_elitism = 0
 
 [MODSReproduction]
-species_bound_fraction = 0.5
-tournament_size = 2
-crossover_rate = 0.5
+species_bound = 0.5
+progression = {progression}
 """
 
 
-def make_config(tmp_path, pop=20, threshold=1.0):
+def make_config(tmp_path, pop=20, threshold=1.0, progression="by_front"):
     path = tmp_path / "mods.cfg"
-    path.write_text(NEAT_CFG.format(pop=pop, threshold=threshold))
-    return neat.Config(neat.DefaultGenome, MODSReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
+    path.write_text(NEAT_CFG.format(pop=pop, threshold=threshold, progression=progression))
+    return neat.Config(BreedingGenome, MODSReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
 
 
 def genome(key, *objectives):
@@ -97,8 +101,7 @@ def genome(key, *objectives):
 
 
 def make_reproduction(fraction=0.5):
-    cfg = SimpleNamespace(species_bound_fraction=fraction, tournament_size=2, crossover_rate=0.5,
-                          progression="by_front")
+    cfg = SimpleNamespace(species_bound=str(fraction), progression="by_front")
     return MODSReproduction(cfg, reporters=None, stagnation=None)
 
 
@@ -197,10 +200,10 @@ def test_missing_objectives_is_an_error(tmp_path):
 
 def test_bad_parameter_named(tmp_path):
     path = tmp_path / "bad.cfg"
-    path.write_text(NEAT_CFG.format(pop=6, threshold=1.0).replace("species_bound_fraction = 0.5",
-                                                                   "species_bound_fraction = 1.5"))
-    with pytest.raises(ValueError, match="species_bound_fraction"):
-        neat.Config(neat.DefaultGenome, MODSReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
+    path.write_text(NEAT_CFG.format(pop=6, threshold=1.0, progression="by_front").replace(
+        "species_bound = 0.5", "species_bound = 1.5"))
+    with pytest.raises(ValueError, match="species_bound"):
+        neat.Config(BreedingGenome, MODSReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
 
 
 def test_deterministic_for_a_seed(tmp_path):

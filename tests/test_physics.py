@@ -12,6 +12,8 @@ from hypothesis import strategies as st
 from gathering_env.config import WorldConfig
 from gathering_env.simulation import GatheringSimulation
 
+pytestmark = pytest.mark.usefixtures("both_kernels")  # every test here runs on both kernels
+
 
 def one_block_world(block_type: int, robots: int, **overrides) -> GatheringSimulation:
     counts = [0, 0, 0]

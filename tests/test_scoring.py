@@ -8,6 +8,8 @@ import pytest
 from gathering_env import parallel_env
 from gathering_env.scoring import gathered_mask, task_performance
 
+pytestmark = pytest.mark.usefixtures("both_kernels")  # every test here runs on both kernels
+
 ZONE = (10.0, 0.0, 30.0, 8.0)
 
 

@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 from gathering_env.config import WorldConfig
-from gathering_env.sensing import SensorBank
+from gathering_env.sensing import sensor_bank
 from gathering_env.sensors import Morphology, SensorSpec
+
+pytestmark = pytest.mark.usefixtures("both_kernels")  # every test here runs on both kernels
 
 R = 0.15  # robot radius
 
@@ -20,7 +22,7 @@ def bank(sensors, blocks=((0.2, 1),), **cfg):
                                      num_robots=3, **cfg)
     half = np.array([b[0] for b in blocks], dtype=float)
     need = np.array([b[1] for b in blocks], dtype=float)
-    return SensorBank(Morphology(sensors), config, half, need)
+    return sensor_bank(Morphology(sensors), config, half, need)
 
 
 def read(b, robots, blocks=()):

@@ -1,3 +1,4 @@
+
 """The vectorised sensing kernel agrees with a plain per-robot, per-sensor, per-object loop.
 
 The reference below is written independently of ``gathering_env.sensing`` from SPEC
@@ -10,12 +11,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gathering_env.config import WorldConfig
-from gathering_env.sensing import SensorBank
+from gathering_env.sensing import sensor_bank
 from gathering_env.sensors import SENSOR_TYPES, Morphology, SensorSpec
+
+pytestmark = pytest.mark.usefixtures("both_kernels")  # every test here runs on both kernels
 
 
 def _angle_diff(a: float, b: float) -> float:
@@ -28,6 +32,15 @@ def _nearest_on_square(p, centre, half, angle):
     lx, ly = rx * c + ry * s, -rx * s + ry * c
     qx, qy = min(max(lx, -half), half), min(max(ly, -half), half)
     return (centre[0] + qx * c - qy * s, centre[1] + qx * s + qy * c)
+
+
+def _distance_to_square(p, centre, half, angle):
+    """Distance from p to the square, measured in the square's frame (exactly 0 inside; a
+    round trip through world coordinates would leave ~1e-16 and lose ties at distance 0)."""
+    c, s = math.cos(angle), math.sin(angle)
+    rx, ry = p[0] - centre[0], p[1] - centre[1]
+    lx, ly = rx * c + ry * s, -rx * s + ry * c
+    return math.hypot(min(max(lx, -half), half) - lx, min(max(ly, -half), half) - ly)
 
 
 def _wall_distance(mount, axis, half_fov, cfg):
@@ -70,7 +83,7 @@ def reference_read(morph, cfg, robot_pos, robot_angle, block_pos, block_angle, b
                     seen.append((dist, "robot", 0))
             for b in range(len(block_pos)):
                 q = _nearest_on_square(mount, block_pos[b], block_half[b], block_angle[b])
-                dist = math.hypot(q[0] - mount[0], q[1] - mount[1])
+                dist = _distance_to_square(mount, block_pos[b], block_half[b], block_angle[b])
                 inside_cone = dist < 1e-12 or _angle_diff(math.atan2(q[1] - mount[1], q[0] - mount[0]), axis) <= s.fov / 2 + 1e-12
                 if inside_cone and dist < s.range:
                     seen.append((dist, "block", block_need[b]))
@@ -134,7 +147,7 @@ def test_kernel_matches_reference(scene):
     block_angle = rng.uniform(-math.pi, math.pi, b)
     block_half = rng.choice([0.2, 0.3, 0.4], b)
     block_need = rng.choice([1, 2, 3], b)
-    bank = SensorBank(morph, cfg, block_half, block_need)
+    bank = sensor_bank(morph, cfg, block_half, block_need)
     got = bank.read(robot_pos, robot_angle, block_pos, block_angle)
     want = reference_read(list(morph), cfg, robot_pos.tolist(), robot_angle.tolist(),
                           block_pos.tolist(), block_angle.tolist(), block_half.tolist(), block_need.tolist())

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from neat.innovation import InnovationTracker
 
+from evolution.breeding import NEATReproduction
 from evolution.genome import CPPNGenome
 from evolution.substrate import Substrate, decode
 from gathering_env import SENSOR_TYPES, parallel_env
@@ -21,7 +22,7 @@ WEIGHT, FOV, ORIENT, RANGE, TYPE, BIAS = range(6)
 
 @pytest.fixture(scope="module")
 def config():
-    cfg = neat.Config(CPPNGenome, neat.DefaultReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(CFG))
+    cfg = neat.Config(CPPNGenome, NEATReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(CFG))
     cfg.genome_config.innovation_tracker = InnovationTracker()
     return cfg
 

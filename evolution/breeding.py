@@ -1,0 +1,264 @@
+"""One breeding routine for both arms: truncation, then one variation operator per offspring.
+
+SO and MO runs differ only in how parents are *selected* (NEAT fitness sharing with
+stagnation in ``NEATReproduction``, speciated NSGA-II in ``evolution.mods``); both then breed
+each species' offspring with ``breed``, so Table 4 compares selection and nothing else.
+
+``breed`` (SPEC sections 5 and 6.5, the original's Encog scheme):
+
+1. **truncation**: the species' candidates, best first by the arm's score (fitness in SO,
+   NSGA-II rank score in MO), are cut to the best ``parent_fraction`` (0.3), at least two
+   where the species has two;
+2. each offspring gets **one operator**, drawn in proportion to its probability:
+   ``crossover`` (two distinct parents; matching genes from either, disjoint and excess genes
+   from the parent with the better score, so in MO the better-ranked one), or a copy of one
+   parent changed by exactly one mutation operator of the genome class (``weights``,
+   ``add_node``, ``add_link``, ``remove_link``, ``remove_node``; NEAT-M adds its sensor
+   operators). A species with a single parent cannot cross over: a drawn crossover becomes
+   a mutation operator drawn from the others.
+
+The probabilities live in the genome's config section (they differ between HyperNEAT-M and
+NEAT-M, and a genome class knows its operators)::
+
+    variation          = one_operator   # or neat_python: crossover with crossover_prob, then
+                                        # neat-python's mutate() with its per-gene rates
+    parent_fraction    = 0.3            # truncation: the best 30 % of a species breed
+    crossover_prob     = 0.5            # HyperNEAT-M 0.5, NEAT-M 0.32
+    weight_mutate_prob = 0.494          # HyperNEAT-M 0.494, NEAT-M 0.335
+    weight_reset_prob  = 0.1            # share of weight operations that reset instead of perturb
+    node_add_prob, conn_add_prob, conn_delete_prob, node_delete_prob   # neat-python's keys
+
+neat-python's keys ``node_add_prob`` ... are per-offspring probabilities in neat-python too,
+so with ``variation = one_operator`` they are the structural operators' probabilities.
+The weight operator is the original's: perturb (Gaussian, ``weight_mutate_power`` /
+``bias_mutate_power``, clamped) or, with ``weight_reset_prob``, re-initialise 1, 2 or 3
+links or 2 % of them (each of the four choices equally likely); a node's bias counts as a
+link from the bias input, as in the original where the bias is a neuron.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections.abc import Callable
+from typing import Any
+
+import neat
+from neat.config import ConfigParameter, DefaultClassConfig
+from neat.math_util import mean
+
+VARIATIONS = ("one_operator", "neat_python")
+WEIGHT_LINK_CHOICES = (1, 2, 3, 0.02)  # links perturbed or reset by one weight operation
+
+
+def add_parameters(config: Any, param_dict: dict[str, str], params: list[ConfigParameter], section: str) -> None:
+    """Interpret extra genome keys with neat-python's ``ConfigParameter`` and register them."""
+    for p in params:
+        try:
+            setattr(config, p.name, p.interpret(param_dict, section))
+        except RuntimeError as err:
+            raise ValueError(f"[{section}] {err}") from None
+    config._params.extend(params)
+
+
+def check_genome_section(config: Any, param_dict: dict[str, str], section: str) -> None:
+    """Raise ``ValueError`` for keys of a genome section that neat-python would silently ignore."""
+    known = {p.name for p in config._params} | {"node_gene_type", "connection_gene_type"}
+    unknown = sorted(set(param_dict) - known)
+    if unknown:
+        raise ValueError(f"[{section}] unknown key(s) {unknown}")
+
+
+def check_probability(section: str, name: str, value: float) -> None:
+    if not 0.0 <= value <= 1.0:
+        raise ValueError(f"[{section}] {name}={value}; allowed: [0, 1]")
+
+
+class BreedingGenome(neat.DefaultGenome):
+    """A ``neat.DefaultGenome`` that knows its variation operators (see module docstring)."""
+
+    EXTRA_PARAMS: tuple[tuple[str, type, Any], ...] = (
+        ("variation", str, "one_operator"),
+        ("parent_fraction", float, None),
+        ("crossover_prob", float, None),
+        ("weight_mutate_prob", float, None),
+        ("weight_reset_prob", float, 0.1),
+    )
+    """Keys of the genome section beyond neat-python's: (name, type, default or None if required)."""
+
+    @classmethod
+    def parse_config(cls, param_dict: dict[str, str]) -> neat.genome.DefaultGenomeConfig:
+        config = super().parse_config(param_dict)
+        section = cls.__name__
+        add_parameters(config, param_dict, [ConfigParameter(*p) for p in cls.EXTRA_PARAMS], section)
+        check_genome_section(config, param_dict, section)
+        cls.validate_config(config, section)
+        return config
+
+    @classmethod
+    def validate_config(cls, config: Any, section: str) -> None:
+        """Check the extra keys (subclasses extend this); raise ``ValueError`` naming the key."""
+        if config.variation not in VARIATIONS:
+            raise ValueError(f"[{section}] variation={config.variation!r}; allowed: {list(VARIATIONS)}")
+        if not 0.0 < config.parent_fraction <= 1.0:
+            raise ValueError(f"[{section}] parent_fraction={config.parent_fraction}; allowed: (0, 1]")
+        for name in ("crossover_prob", "weight_mutate_prob", "weight_reset_prob"):
+            check_probability(section, name, getattr(config, name))
+        if config.variation == "one_operator" and sum(p for _, p in cls.operators(config)) <= 0:
+            raise ValueError(f"[{section}] every operator probability is 0; allowed: at least one > 0")
+
+    @classmethod
+    def operators(cls, config: Any) -> list[tuple[str, float]]:
+        """(operator, probability) of one offspring, crossover first."""
+        return [("crossover", config.crossover_prob), ("weights", config.weight_mutate_prob),
+                ("add_node", config.node_add_prob), ("remove_node", config.node_delete_prob),
+                ("add_link", config.conn_add_prob), ("remove_link", config.conn_delete_prob)]
+
+    def apply_operator(self, name: str, config: Any) -> None:
+        """Apply one mutation operator (any name of ``operators`` except crossover)."""
+        if name == "weights":
+            self.mutate_weights(config)
+        elif name == "add_node":
+            self.mutate_add_node(config)
+        elif name == "remove_node":
+            self.mutate_delete_node(config)
+        elif name == "add_link":
+            self.mutate_add_connection(config)
+        elif name == "remove_link":
+            self.mutate_delete_connection()
+        else:
+            raise ValueError(f"unknown variation operator {name!r}")
+
+    def mutate_weights(self, config: Any) -> None:
+        """Perturb or reset 1, 2, 3 or 2 % of the links (enabled connections and node biases)."""
+        links = [(g, "weight") for _, g in sorted(self.connections.items()) if g.enabled]
+        links += [(g, "bias") for _, g in sorted(self.nodes.items())]
+        if not links:
+            return
+        pick = random.choice(WEIGHT_LINK_CHOICES)
+        k = pick if isinstance(pick, int) else max(1, round(pick * len(links)))
+        reset = random.random() < config.weight_reset_prob
+        for gene, name in random.sample(links, min(k, len(links))):
+            attribute = next(a for a in gene._gene_attributes if a.name == name)
+            if reset:
+                value = attribute.init_value(config)
+            else:
+                power = getattr(config, attribute.mutate_power_name)
+                value = attribute.clamp(getattr(gene, name) + random.gauss(0.0, power), config)
+            setattr(gene, name, value)
+
+
+class _Scored:
+    """A parent seen by neat-python's crossover with ``fitness`` replaced by the breeding score."""
+
+    def __init__(self, genome: Any, score: float) -> None:
+        self._genome = genome
+        self.fitness = score
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._genome, name)
+
+
+def truncate(candidates: list[int], fraction: float) -> list[int]:
+    """The best ``fraction`` of ``candidates`` (sorted best first), at least two where possible."""
+    keep = max(int(math.ceil(fraction * len(candidates))), min(2, len(candidates)))
+    return candidates[:keep]
+
+
+def breed(candidates: list[int], genomes: dict[int, Any], score: dict[int, float], count: int,
+          config: Any, new_key: Callable[[], int], ancestors: dict[int, tuple[int, ...]]) -> dict[int, Any]:
+    """``count`` offspring of one species (see the module docstring).
+
+    Args:
+        candidates: genome ids of the species, sorted best first by ``score``.
+        genomes: id -> genome. score: id -> the arm's breeding score (higher is better).
+        config: the ``neat.Config``. new_key: gives the next genome id.
+        ancestors: filled with child id -> parent ids.
+    """
+    gcfg = config.genome_config
+    parents = truncate(candidates, gcfg.parent_fraction)
+    ops = config.genome_type.operators(gcfg)
+    names, weights = [n for n, _ in ops], [w for _, w in ops]
+    children: dict[int, Any] = {}
+    for _ in range(count):
+        key = new_key()
+        child = config.genome_type(key)
+        if gcfg.variation == "one_operator":
+            op = random.choices(names, weights)[0]
+            if op == "crossover" and len(parents) < 2 and sum(weights[1:]) > 0:
+                op = random.choices(names[1:], weights[1:])[0]  # one parent: a mutation instead
+            crossover = op == "crossover"
+        else:
+            op = None
+            crossover = random.random() < gcfg.crossover_prob
+        if crossover and len(parents) > 1:
+            p1, p2 = random.sample(parents, 2)
+            child.configure_crossover(_Scored(genomes[p1], score[p1]), _Scored(genomes[p2], score[p2]), gcfg)
+            ancestors[key] = (p1, p2)
+        else:
+            p1 = random.choice(parents)
+            copy = _Scored(genomes[p1], 0.0)
+            child.configure_crossover(copy, copy, gcfg)  # a copy of one parent
+            ancestors[key] = (p1,)
+            if op is not None and op != "crossover":
+                child.apply_operator(op, gcfg)
+        if op is None:
+            child.mutate(gcfg)
+        children[key] = child
+    return children
+
+
+class NEATReproduction(neat.DefaultReproduction):
+    """neat-python's NEAT selection (fitness sharing, stagnation, elitism) with ``breed``.
+
+    Config section ``[NEATReproduction]``: ``elitism`` and ``min_species_size`` as in
+    neat-python's ``DefaultReproduction``; the truncation fraction is the genome section's
+    ``parent_fraction`` (one value shared with the MO arm).
+    """
+
+    @classmethod
+    def parse_config(cls, param_dict: dict[str, str]) -> DefaultClassConfig:
+        if "survival_threshold" in param_dict:
+            raise ValueError(f"[{cls.__name__}] survival_threshold: set the truncation fraction as parent_fraction "
+                             "in the genome section (shared by the SO and MO arms)")
+        return DefaultClassConfig(param_dict, [ConfigParameter("elitism", int, 0),
+                                               ConfigParameter("min_species_size", int, 1)], cls.__name__)
+
+    def reproduce(self, config: Any, species: Any, pop_size: int, generation: int) -> dict[int, Any]:
+        config.genome_config.innovation_tracker = self.innovation_tracker
+        self.innovation_tracker.reset_generation()
+        remaining, fitnesses = [], []
+        for sid, s, stagnant in self.stagnation.update(species, generation):
+            if stagnant:
+                self.reporters.species_stagnant(sid, s)
+            else:
+                fitnesses.extend(m.fitness for m in s.members.values())
+                remaining.append(s)
+        if not remaining:
+            species.species = {}
+            return {}
+        low, span = min(fitnesses), max(1.0, max(fitnesses) - min(fitnesses))
+        for s in remaining:  # neat-python's adjusted fitness
+            s.adjusted_fitness = (mean([m.fitness for m in s.members.values()]) - low) / span
+        cfg = self.reproduction_config
+        min_size = max(cfg.min_species_size, cfg.elitism)
+        spawn = self.compute_spawn([s.adjusted_fitness for s in remaining], [len(s.members) for s in remaining],
+                                   pop_size, min_size)
+        spawn = self._adjust_spawn_exact(spawn, pop_size, min_size)
+
+        new_population: dict[int, Any] = {}
+        species.species = {}
+        for n, s in zip(spawn, remaining):
+            n = max(n, cfg.elitism)
+            members = dict(s.members)
+            s.members = {}
+            species.species[s.key] = s
+            ranked = sorted(members, key=lambda k: (members[k].fitness, k), reverse=True)
+            elites = ranked[:cfg.elitism]
+            for k in elites:
+                new_population[k] = members[k]
+            n -= len(elites)
+            score = {k: float(members[k].fitness) for k in ranked}
+            new_population.update(breed(ranked, members, score, n, config, lambda: next(self.genome_indexer),
+                                        self.ancestors))
+        return new_population

@@ -1,0 +1,159 @@
+"""Held-out re-evaluation of a run's final genomes, for unbiased figures in the analysis.
+
+Both samples of Table 4 are maxima over noisy evaluations: an SO champion is the best
+training score a run ever saw, and an MO front holds the genomes whose training scores
+happened to be non-dominated. Their training scores are therefore biased upward.
+``reevaluate_run`` runs the champion (``champion.json``) and every front genome
+(``front/*.json``) of a run again, ``trials`` times, on **held-out seeds**, through the
+evaluation backends (``evolution.backends``), and caches the results in the run directory.
+
+Held-out seeds. Training trial seeds are ``trial_seed(run seed, generation, trial)``, i.e.
+``SeedSequence([run seed, generation, trial])`` with generation < the run's generations.
+Re-evaluation calls ``evaluate`` with ``generation = HELDOUT_GENERATION`` (2**32 - 1, a tag
+no run reaches), so its seeds are ``SeedSequence([run seed, 2**32 - 1, t])`` for t < K: a
+separate domain, the same K worlds for every genome of a run. The K seeds are also checked
+against every training seed of the run; on a (32-bit) collision the next tag down is used.
+
+Cache: ``RUN_DIR/reevaluation.json`` (written atomically; an existing file of another
+format is never overwritten). Each entry is keyed by a hash of the genome's genes, the
+method, environment and substrate, and the list of held-out seeds (so the run seed and K),
+and holds the objectives and per-trial ft.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import Any
+
+from .backends import EvalContext, make_evaluator
+from .champion import ChampionError, genome_from_dict
+from .checkpoint import atomic_write_bytes
+from .evaluate import trial_seed
+
+REEVALUATE_TRIALS = 20
+"""Default K of ``gathering-analyze --reevaluate``."""
+HELDOUT_GENERATION = 2**32 - 1
+CACHE_FILE = "reevaluation.json"
+CACHE_FORMAT = "gathering-evolution/reevaluation"
+CACHE_VERSION = 1
+
+
+def training_seeds(run_seed: int, generations: int, trials: int) -> set[int]:
+    """Every trial seed a run of ``generations`` generations used in training."""
+    return {trial_seed(run_seed, g, t) for g in range(generations) for t in range(trials)}
+
+
+def heldout_generation(run_seed: int, generations: int, trials: int, k: int) -> int:
+    """The ``generation`` tag whose K trial seeds avoid every training seed of the run."""
+    used = training_seeds(run_seed, generations, trials)
+    tag = HELDOUT_GENERATION
+    while any(trial_seed(run_seed, tag, t) in used for t in range(k)):
+        tag -= 1
+    return tag
+
+
+def heldout_seeds(run_seed: int, generations: int, trials: int, k: int) -> list[int]:
+    """The K held-out episode seeds of a run (see the module docstring)."""
+    tag = heldout_generation(run_seed, generations, trials, k)
+    return [trial_seed(run_seed, tag, t) for t in range(k)]
+
+
+def _run_setup(run_dir: Path) -> tuple[Any, Any, Any]:
+    """(experiment, neat config, substrate) of a run directory, from its own copies."""
+    from .experiment import Experiment, ExperimentError
+    from .trainer import make_neat_config, substrate_for
+
+    doc = json.loads((run_dir / "experiment.json").read_text())
+    doc.pop("source", None)
+    doc["objectives"] = tuple(doc.get("objectives", ("task",)))
+    doc["neat_config"] = run_dir / "neat.cfg"
+    try:
+        experiment = Experiment(**doc, source=str(run_dir / "experiment.json"))
+        config = make_neat_config(experiment)
+    except (TypeError, ExperimentError) as err:
+        raise ValueError(f"{run_dir}: cannot rebuild the run's configuration for re-evaluation ({err}); "
+                         "use --reevaluate 0 for its training scores") from None
+    return experiment, config, substrate_for(experiment)
+
+
+def _load_cache(path: Path) -> dict[str, Any]:
+    if not path.exists():
+        return {}
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        doc = None
+    if not isinstance(doc, dict) or doc.get("format") != CACHE_FORMAT:
+        raise ValueError(f"{path}: exists and is not a re-evaluation cache; move it away (it is not overwritten)")
+    if doc.get("version") != CACHE_VERSION:
+        return {}
+    return dict(doc.get("entries", {}))
+
+
+def _entry_key(genome: dict[str, Any], experiment: Any, seeds: list[int]) -> str:
+    blob = json.dumps({"genome": genome, "method": experiment.method, "environment": experiment.environment,
+                       "substrate": experiment.substrate, "seeds": seeds}, sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()[:24]
+
+
+def reevaluate_run(run_dir: Path, trials: int, workers: int | None = None, backend: str = "process",
+                   generations: int | None = None) -> dict[str, dict[str, Any]]:
+    """Held-out objectives of the champion and front genomes of one run.
+
+    Args:
+        run_dir: a run directory. trials: K held-out trials per genome (>= 1).
+        workers, backend: as for ``evolution.backends.make_evaluator``.
+        generations: generations the run trained (default: from its experiment).
+
+    Returns:
+        file name relative to ``run_dir`` (``champion.json``, ``front/genome-N.json``) ->
+        ``{"task", "morphology", "controller", "trial_ft", "seeds"}``.
+    """
+    if trials < 1:
+        raise ValueError(f"trials={trials}; allowed: >= 1")
+    run_dir = Path(run_dir)
+    files = [p for p in [run_dir / "champion.json"] if p.exists()] + sorted((run_dir / "front").glob("*.json"))
+    if not files:
+        return {}
+    experiment, config, substrate = _run_setup(run_dir)
+    gens = max(generations or 0, experiment.generations)
+    tag = heldout_generation(experiment.seed, gens, experiment.trials, trials)
+    seeds = [trial_seed(experiment.seed, tag, t) for t in range(trials)]
+    cache_path = run_dir / CACHE_FILE
+    cache = _load_cache(cache_path)
+
+    results: dict[str, dict[str, Any]] = {}
+    todo: list[tuple[str, str, Any]] = []
+    for path in files:
+        name = path.relative_to(run_dir).as_posix()
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))["genome"]
+            genome = genome_from_dict(data, config)
+        except (json.JSONDecodeError, KeyError, TypeError, ChampionError) as err:
+            raise ValueError(f"{path}: cannot re-evaluate its genome: {err}") from None
+        key = _entry_key(data, experiment, seeds)
+        if key in cache:
+            results[name] = cache[key]
+        else:
+            todo.append((name, key, genome))
+    if todo:
+        context = EvalContext(config, dict(experiment.environment), trials, experiment.seed, experiment.method,
+                              substrate)
+        evaluator = make_evaluator(context, workers, backend)
+        try:
+            evaluations = evaluator.map([g for _, _, g in todo], tag)
+        finally:
+            evaluator.close()
+        if evaluator.failures:
+            key, error = evaluator.failures[0]
+            raise ValueError(f"{run_dir}: re-evaluating genome {key} failed: {error}")
+        for (name, key, _), ev in zip(todo, evaluations):
+            cache[key] = results[name] = {
+                "task": ev.task, "morphology": ev.morphology, "controller": ev.controller,
+                "trial_ft": list(ev.trial_ft), "seeds": seeds,
+            }
+        doc = {"format": CACHE_FORMAT, "version": CACHE_VERSION, "entries": cache}
+        atomic_write_bytes(cache_path, (json.dumps(doc, indent=1) + "\n").encode())
+    return results

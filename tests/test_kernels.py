@@ -1,0 +1,285 @@
+"""The compiled kernels against the numpy reference: readings, whole episodes, many worlds.
+
+The numpy implementation (``SensorBank``, ``NumpySimulation``) is the reference; the
+compiled one must give the same readings (to 1e-9, in float64) on generated scenes that
+include the hard cases (objects exactly on a cone's edge or at the range limit, rotated
+blocks, robots touching walls), the same trajectories and task performance over whole
+episodes with every world option, and the same worlds when W of them are stepped together.
+"""
+
+from __future__ import annotations
+
+import math
+import pickle
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from gathering_env import parallel_env
+from gathering_env.config import WorldConfig
+from gathering_env.kernels import CompiledSensorBank
+from gathering_env.policies import WanderTeam
+from gathering_env.sensing import SensorBank
+from gathering_env.sensors import SENSOR_TYPES, Morphology, SensorSpec
+from gathering_env.simulation import CompiledSimulation, GatheringSimulation, NumpySimulation
+from gathering_env.vector import VectorSimulation
+
+R = 0.15
+
+
+def _sensor(draw, kind):
+    spec = SENSOR_TYPES[kind]
+    if not spec.configurable:
+        return SensorSpec("bottom")
+    return SensorSpec(
+        kind,
+        bearing=draw(st.sampled_from([0.0, math.pi, -math.pi, math.pi / 2]) | st.floats(-math.pi, math.pi)),
+        orientation=draw(st.sampled_from([0.0, math.pi / 2, -math.pi / 2]) | st.floats(-math.pi / 2, math.pi / 2)),
+        range=draw(st.sampled_from([spec.range_max]) | st.floats(0.05, spec.range_max)),
+        fov=draw(st.sampled_from([spec.fov_min, spec.fov_max]) | st.floats(spec.fov_min, spec.fov_max)),
+    )
+
+
+@st.composite
+def scenes(draw):
+    kinds = draw(st.lists(st.sampled_from(list(SENSOR_TYPES)), min_size=1, max_size=10))
+    morph = Morphology([_sensor(draw, k) for k in kinds])
+    n = draw(st.integers(2, 10))
+    b = draw(st.integers(1, 8))
+    size = draw(st.sampled_from([3.0, 8.0, 40.0]))
+    seed = draw(st.integers(0, 2**32 - 1))
+    edge_cases = draw(st.booleans())
+    gamma = draw(st.booleans())
+    return morph, n, b, size, seed, edge_cases, gamma
+
+
+def _place_on_edges(morph, robot_pos, robot_angle, block_pos, block_angle, block_half, rng):
+    """Put objects exactly on the cone edge and/or at the range limit of robot 0's sensors,
+    and robots touching the walls."""
+    cones = [s for s in morph if s.type != "bottom"]
+    if not cones:
+        return
+    x, y, a = robot_pos[0, 0], robot_pos[0, 1], robot_angle[0]
+    for k in range(1, len(robot_pos)):
+        s = cones[k % len(cones)]
+        mount = a + s.bearing
+        mx, my = x + R * math.cos(mount), y + R * math.sin(mount)
+        axis = mount + s.orientation
+        direction = axis + rng.choice([-0.5, 0.5, 0.0]) * s.fov       # edge or axis
+        centre = s.range + R if rng.random() < 0.5 else rng.uniform(0.0, s.range + R)  # range limit
+        robot_pos[k] = (mx + centre * math.cos(direction), my + centre * math.sin(direction))
+    for b in range(len(block_pos)):
+        s = cones[b % len(cones)]
+        mount = a + s.bearing
+        mx, my = x + R * math.cos(mount), y + R * math.sin(mount)
+        axis = mount + s.orientation + rng.choice([-0.5, 0.5]) * s.fov
+        # an axis-aligned block whose near face lies exactly at the range, on the edge ray
+        block_angle[b] = 0.0 if rng.random() < 0.5 else axis
+        d = s.range + block_half[b]
+        block_pos[b] = (mx + d * math.cos(axis), my + d * math.sin(axis))
+    # robots inside the arena, some touching a wall or overlapping it by a contact's slack
+    np.clip(robot_pos, R, None, out=robot_pos)
+    if len(robot_pos) > 2:
+        robot_pos[-1, 0] = R
+        robot_pos[-2, 1] = R - 0.05
+
+
+@settings(max_examples=200, deadline=None)
+@given(scenes())
+def test_compiled_readings_equal_the_numpy_reference(scene):
+    morph, n, b, size, seed, edge_cases, gamma = scene
+    rng = np.random.default_rng(seed)
+    cfg = WorldConfig.from_kwargs(environment=None, block_counts=(b, 0, 0), num_robots=n,
+                                  arena_width=size, arena_height=size, zone_width=size / 2,
+                                  zone_depth=size / 5, ir_response="gamma" if gamma else "linear")
+    robot_pos = rng.uniform(R, size - R, (n, 2))
+    robot_angle = rng.uniform(-math.pi, math.pi, n)
+    block_pos = rng.uniform(0.2, size - 0.2, (b, 2))
+    block_angle = rng.uniform(-math.pi, math.pi, b)
+    block_half = rng.choice([0.2, 0.3, 0.4], b)
+    block_need = rng.choice([1, 2, 3], b).astype(float)
+    if edge_cases:
+        _place_on_edges(morph, robot_pos, robot_angle, block_pos, block_angle, block_half, rng)
+        np.clip(robot_pos, R - 0.05, size - R + 0.05, out=robot_pos)
+    want = SensorBank(morph, cfg, block_half, block_need).read(robot_pos, robot_angle, block_pos, block_angle,
+                                                               dtype=np.float64)
+    got = CompiledSensorBank(morph, cfg, block_half, block_need).read(robot_pos, robot_angle, block_pos,
+                                                                      block_angle, dtype=np.float64)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
+    assert ((got >= 0) & (got <= 1)).all()
+
+
+# ---------------------------------------------------------------------------- episodes
+MIXED = Morphology([
+    SensorSpec("bottom"),
+    SensorSpec("ultrasonic", 0.0, 0.0, 25.0, 1.0),
+    SensorSpec("camera", 0.5, 0.2, 20.0, 2.0),
+    SensorSpec("colour", -0.7, -0.3, 10.0, 1.5),
+    SensorSpec("infrared", 2.5, 0.4, 3.0, 2.0),
+    SensorSpec("ultrasonic", -math.pi, 0.0, 4.0, 0.5),
+])
+
+# A small arena so that robots meet blocks, attach, and gather them within a few hundred steps.
+SMALL = dict(environment=None, arena_width=10.0, arena_height=10.0, zone_width=5.0, zone_depth=2.0,
+             block_counts=(4, 3, 2), num_robots=12)
+
+
+def _episode(kernel: str, steps: int, morphology: Morphology, seed: int, **world):
+    cfg = WorldConfig.from_kwargs(kernel=kernel, max_cycles=steps, **world)
+    sim = GatheringSimulation(cfg, morphology)
+    obs = sim.reset(seed=seed)
+    team = WanderTeam(morphology, seed=seed)
+    rng = np.random.default_rng(seed)
+    record = {"obs": [obs], "pose": [], "reward": [], "attached": [], "gathered": []}
+    while True:
+        wheels = team.act(obs)
+        wheels[::3] = rng.uniform(-1.5, 1.5, wheels[::3].shape)   # some random and out-of-range commands
+        obs, reward, terminated, truncated = sim.step(wheels)
+        w = sim.world
+        record["obs"].append(obs)
+        record["pose"].append(np.concatenate([w.robot_pos.ravel(), w.robot_angle, w.block_pos.ravel(),
+                                              w.block_angle]))
+        record["reward"].append(reward)
+        record["attached"].append(w.robot_attached.copy())
+        record["gathered"].append(sim.gathered.copy())
+        if terminated or truncated:
+            break
+    return sim, record
+
+
+@pytest.mark.parametrize("world", [
+    dict(SMALL),
+    dict(SMALL, collision_avoidance=True),
+    dict(SMALL, pickup_positioning=True),
+    dict(SMALL, ir_response="gamma", physics_substeps=2),
+    dict(environment=3, num_robots=20),
+], ids=["small", "avoidance", "positioning", "gamma-substeps", "env3"])
+def test_whole_episodes_are_identical_on_both_kernels(world):
+    steps = 400
+    attached = gathered = False
+    for morphology in (Morphology.khepera_iii(), MIXED):
+        ref, want = _episode("numpy", steps, morphology, 7, **world)
+        sim, got = _episode("compiled", steps, morphology, 7, **world)
+        assert isinstance(ref, NumpySimulation) and isinstance(sim, CompiledSimulation)
+        for key in want:
+            np.testing.assert_array_equal(np.asarray(got[key]), np.asarray(want[key]), err_msg=key)
+        assert sim.task_performance() == ref.task_performance()
+        assert sim.steps == ref.steps and sim.blocks_gathered_by_type() == ref.blocks_gathered_by_type()
+        attached |= bool(np.asarray(want["attached"]).max() >= 0)
+        gathered |= bool(np.asarray(want["gathered"]).any())
+    if world.get("arena_width") == 10.0:
+        # the comparison covered attachments and gathering (with releases), not only driving
+        assert attached and gathered
+
+
+def test_episode_that_terminates_early_is_identical():
+    world = dict(SMALL, block_counts=(1, 0, 0), num_robots=15)
+    for seed in range(6):
+        ref, want = _episode("numpy", 3000, Morphology.khepera_iii(), seed, **world)
+        sim, got = _episode("compiled", 3000, Morphology.khepera_iii(), seed, **world)
+        np.testing.assert_array_equal(np.asarray(got["pose"]), np.asarray(want["pose"]))
+        assert (sim.steps, sim.task_performance()) == (ref.steps, ref.task_performance())
+    # at least one of these episodes ended by gathering everything (time bonus paid)
+    assert any(_episode("compiled", 3000, Morphology.khepera_iii(), s, **world)[0].task_performance() > 100
+               for s in range(6))
+
+
+# ---------------------------------------------------------------------------- many worlds
+@pytest.mark.parametrize("kernel", ["compiled", "numpy"])
+def test_each_world_of_a_batch_is_the_world_stepped_alone(kernel):
+    seeds = [11, 12, 13]
+    world = dict(SMALL, kernel=kernel, max_cycles=150)
+    sims = VectorSimulation(3, **world, morphology=MIXED)
+    alone = [GatheringSimulation(WorldConfig.from_kwargs(**world), MIXED) for _ in seeds]
+    obs = sims.reset(seeds)
+    for w, sim in enumerate(alone):
+        np.testing.assert_array_equal(obs[w], sim.reset(seed=seeds[w]))
+    rng = np.random.default_rng(0)
+    restarted = False
+    while sims.active.any():
+        wheels = rng.uniform(-1, 1, (3, SMALL["num_robots"], 2))
+        before = [s.world.robot_pos.copy() for s in alone]
+        active = sims.active
+        obs, reward, terminated, truncated = sims.step(wheels)
+        for w, sim in enumerate(alone):
+            if active[w]:
+                o, r, te, tr = sim.step(wheels[w])
+                np.testing.assert_array_equal(obs[w], o)
+                assert (reward[w], terminated[w], truncated[w]) == (r, te, tr)
+            else:   # masked out: not stepped
+                assert reward[w] == 0.0
+                np.testing.assert_array_equal(sims.worlds[w].robot_pos, before[w])
+        if not restarted and sims.steps[1] == 60:
+            # world 1 starts over: it ends 60 steps after the others
+            np.testing.assert_array_equal(sims.reset_world(1, 99), alone[1].reset(seed=99))
+            restarted = True
+    assert sims.steps.tolist() == [150, 150, 150]
+    np.testing.assert_array_equal(sims.task_performance(), [s.task_performance() for s in alone])
+    np.testing.assert_array_equal(sims.blocks_gathered_by_type(), [s.blocks_gathered_by_type() for s in alone])
+
+
+def test_compiled_and_numpy_batches_agree():
+    runs = {}
+    for kernel in ("compiled", "numpy"):
+        sims = VectorSimulation(4, environment=2, max_cycles=200, kernel=kernel)
+        obs = sims.reset([0, 1, 2, 3])
+        team = WanderTeam(sims.morphology, seed=0)
+        trace = [obs]
+        while sims.active.any():
+            obs, reward, *_ = sims.step(team.act(obs.reshape(-1, obs.shape[-1])).reshape(4, -1, 2))
+            trace.append(obs)
+        runs[kernel] = (np.stack(trace), sims.task_performance())
+    np.testing.assert_array_equal(runs["compiled"][0], runs["numpy"][0])
+    np.testing.assert_array_equal(runs["compiled"][1], runs["numpy"][1])
+
+
+def test_vector_bad_input():
+    with pytest.raises(ValueError, match=r"num_worlds=0; allowed: an integer in \[1, 4096\]"):
+        VectorSimulation(0)
+    with pytest.raises(ValueError, match="kernel='fast'; allowed: 'compiled', 'numpy'"):
+        VectorSimulation(2, kernel="fast")
+    sims = VectorSimulation(2, environment=1, max_cycles=5)
+    with pytest.raises(RuntimeError, match="reset"):
+        sims.step(np.zeros((2, 20, 2)))
+    with pytest.raises(ValueError, match="seeds must be a sequence of 2 seeds"):
+        sims.reset([1])
+    with pytest.raises(ValueError, match=r"seeds\[1\]=True"):
+        sims.reset([1, True])
+    sims.reset([1, 2])
+    with pytest.raises(ValueError, match=r"expected \(2, 20, 2\)"):
+        sims.step(np.zeros((20, 2)))
+    bad = np.zeros((2, 20, 2))
+    bad[1, 4, 0] = np.nan
+    with pytest.raises(ValueError, match="world 1, robot_4 .* NaN/inf not allowed"):
+        sims.step(bad)
+    with pytest.raises(ValueError, match=r"world=2; allowed: an integer in \[0, 1\]"):
+        sims.reset_world(2, 0)
+    for _ in range(5):
+        sims.step(np.zeros((2, 20, 2)))
+    with pytest.raises(RuntimeError, match="every world's episode ended"):
+        sims.step(np.zeros((2, 20, 2)))
+
+
+def test_bad_kernel_name_names_the_allowed_values():
+    with pytest.raises(ValueError, match="kernel='numba'; allowed: 'compiled', 'numpy'"):
+        parallel_env(kernel="numba")
+
+
+@pytest.mark.parametrize("kernel", ["compiled", "numpy"])
+def test_pickled_env_continues_identically(kernel):
+    env = parallel_env(environment=2, max_cycles=300, kernel=kernel)
+    obs, _ = env.reset(seed=4)
+    rng = np.random.default_rng(1)
+    for _ in range(50):
+        env.step({a: rng.uniform(-1, 1, 2) for a in env.agents})
+    twin = pickle.loads(pickle.dumps(env))
+    for _ in range(100):
+        actions = {a: rng.uniform(-1, 1, 2) for a in env.agents}
+        o1, r1, *_ = env.step(actions)
+        o2, r2, *_ = twin.step(actions)
+        for agent in o1:
+            np.testing.assert_array_equal(o1[agent], o2[agent])
+        assert r1 == r2
+    np.testing.assert_array_equal(env.sim.world.robot_pos, twin.sim.world.robot_pos)

@@ -1,0 +1,126 @@
+"""Held-out re-evaluation: seeds disjoint from training, replayed scores, cache, CLI."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+import small_runs
+
+from evolution.analysis import analyse
+from evolution.champion import genome_from_dict, load_champion
+from evolution.cli import analyze_main
+from evolution.evaluate import evaluate, trial_seed
+from evolution.pareto import non_dominated_fronts
+from evolution.reevaluate import CACHE_FILE, _run_setup, heldout_seeds, reevaluate_run, training_seeds
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """Copies of the shared small runs (re-evaluation writes its cache into them)."""
+    _, so, _, mo = small_runs.build(tmp_path_factory)
+    root = tmp_path_factory.mktemp("reeval")
+    shutil.copytree(so, root / "so")
+    shutil.copytree(mo, root / "mo")
+    return root / "so", root / "mo"
+
+
+def test_heldout_seeds_are_disjoint_from_training():
+    train = training_seeds(7, 250, 5)
+    held = heldout_seeds(7, 250, 5, 20)
+    assert len(set(held)) == 20 and not set(held) & train
+    # brute force: no (generation, trial) of the run gives a held-out seed
+    assert all(trial_seed(7, g, t) not in set(held) for g in range(250) for t in range(5))
+
+
+def test_replayed_champion_reproduces_its_stored_score(runs):
+    so, _ = runs
+    experiment, config, substrate = _run_setup(so)
+    champion = load_champion(so / "champion.json")
+    genome = genome_from_dict(champion.genome, config)
+    ev = evaluate(genome, config, experiment.environment, trials=experiment.trials, seed=experiment.seed,
+                  generation=champion.generation, method=experiment.method, substrate=substrate)
+    assert ev.task == pytest.approx(champion.objectives["task"])
+    assert ev.morphology == pytest.approx(champion.objectives["morphology"])
+    # the mean ft over trials run on distinct seeds is the fitness
+    seeds = {trial_seed(experiment.seed, champion.generation, t) for t in range(experiment.trials)}
+    assert len(seeds) == experiment.trials and ev.task == pytest.approx(np.mean(ev.trial_ft))
+
+
+def test_reevaluation_uses_heldout_seeds_and_is_cached(runs):
+    so, mo = runs
+    scores = reevaluate_run(mo, 3, workers=1, backend="serial")
+    front_files = sorted(p.relative_to(mo).as_posix() for p in (mo / "front").glob("*.json"))
+    assert set(front_files) <= set(scores) and "champion.json" in scores
+    experiment, config, substrate = _run_setup(mo)
+    expected_seeds = heldout_seeds(experiment.seed, experiment.generations, experiment.trials, 3)
+    for name, entry in scores.items():
+        assert entry["seeds"] == expected_seeds and len(entry["trial_ft"]) == 3
+        doc = json.loads((mo / name).read_text())
+        assert entry["morphology"] == pytest.approx(doc["objectives"]["morphology"])
+    cache = json.loads((mo / CACHE_FILE).read_text())
+    assert len(cache["entries"]) == len({json.dumps(json.loads((mo / n).read_text())["genome"]) for n in scores})
+    mtime = (mo / CACHE_FILE).stat().st_mtime_ns
+    assert reevaluate_run(mo, 3, workers=1, backend="serial") == scores     # served from the cache
+    assert (mo / CACHE_FILE).stat().st_mtime_ns == mtime                   # not rewritten
+    so_scores = reevaluate_run(so, 3, workers=1, backend="serial")
+    champion = load_champion(so / "champion.json")
+    held_out = so_scores["champion.json"]
+    assert held_out["task"] != champion.objectives["task"]                # new worlds, another score
+    assert held_out["task"] == pytest.approx(np.mean(reference_ft(champion, held_out["seeds"])))
+
+
+def reference_ft(champion, seeds):
+    """ft of the champion's stored team on each seed, by a plain loop over the environment."""
+    from gathering_env import parallel_env
+
+    env = parallel_env(**champion.environment)
+    fts = []
+    for seed in seeds:
+        obs, _ = env.reset(seed=seed, options={"morphology": champion.morphology})
+        obs = np.stack([obs[a] for a in env.possible_agents])
+        while True:
+            obs, _, terminated, truncated = env.step_batch(champion.controller.act(obs))
+            if terminated or truncated:
+                break
+        fts.append(env.team_info()["task_performance"])
+    return fts
+
+
+def test_analysis_with_reevaluation_is_reproducible(runs, tmp_path):
+    so, mo = runs
+    a = analyse([so, mo], reevaluate=3, workers=1, backend="serial")
+    b = analyse([so, mo], reevaluate=3, workers=1, backend="serial")
+    assert a.scores.startswith("held-out") and b.scores == a.scores
+    assert np.array_equal(a.so_points[1], b.so_points[1])
+    assert all(np.array_equal(a.run_points[1][p], b.run_points[1][p]) for p in a.run_points[1])
+    front = a.runs[1].front
+    assert len(non_dominated_fronts(front)[0]) == len(front)              # still a front
+    training = analyse([so, mo])
+    assert training.scores.startswith("training")
+    assert a.runs[0].champion_training == training.runs[0].champion
+    out = tmp_path / "report"
+    assert analyze_main([str(so), str(mo), "--out", str(out), "--reevaluate", "3", "--workers", "1"]) == 0
+    assert "held-out" in (out / "report.md").read_text()
+
+
+def test_reevaluation_never_overwrites_a_foreign_file(runs, tmp_path, capsys):
+    so, _ = runs
+    copy = tmp_path / "copy"
+    shutil.copytree(so, copy)
+    (copy / CACHE_FILE).write_text("my notes\n")
+    assert analyze_main([str(copy), "--out", str(tmp_path / "r"), "--reevaluate", "2", "--workers", "1"]) == 2
+    assert "not a re-evaluation cache" in capsys.readouterr().err
+    assert (copy / CACHE_FILE).read_text() == "my notes\n"
+
+
+@pytest.mark.parametrize("args, needle", [(["--reevaluate", "-1"], "--reevaluate"),
+                                          (["--workers", "0"], "--workers"),
+                                          (["--backend", "gpu"], "--backend")])
+def test_bad_reevaluation_options(runs, tmp_path, capsys, args, needle):
+    so, _ = runs
+    assert analyze_main([str(so), "--out", str(tmp_path / "r"), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: " + needle) and "allowed" in err

@@ -1,0 +1,114 @@
+"""Whole runs against hand values: fitness = mean ft on distinct seeds, the SO convergence
+stop at the paper's threshold, non-dominated front files, NEAT-M / MO resume."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import small_runs
+from small_runs import evolve, experiment_file
+
+from evolution import trainer as trainer_module
+from evolution.champion import genome_from_dict, load_champion
+from evolution.evaluate import Evaluation, evaluate, sensor_statistics, trial_seed
+from evolution.experiment import load_experiment
+from evolution.reevaluate import _run_setup
+from evolution.stats import read_stats, without_timing
+from gathering_env import Morphology, parallel_env
+
+
+@pytest.fixture(scope="module")
+def mo_run(tmp_path_factory):
+    _, _, exp, run = small_runs.build(tmp_path_factory)
+    return exp, run
+
+
+def team_ft(controller, morphology, env_config, seed):
+    """ft of one episode by a plain loop over the public environment API."""
+    env = parallel_env(**env_config)
+    obs, _ = env.reset(seed=seed, options={"morphology": morphology})
+    obs = np.stack([obs[a] for a in env.possible_agents])
+    while True:
+        obs, _, terminated, truncated = env.step_batch(controller.act(obs))
+        if terminated or truncated:
+            return env.team_info()["task_performance"]
+
+
+def test_fitness_is_the_mean_ft_over_distinct_trial_seeds(mo_run):
+    _, run = mo_run
+    experiment, config, substrate = _run_setup(run)
+    champion = load_champion(run / "champion.json")
+    genome = genome_from_dict(champion.genome, config)
+    seeds = [trial_seed(experiment.seed, 1, t) for t in range(4)]
+    assert len(set(seeds)) == 4
+    ev = evaluate(genome, config, experiment.environment, trials=4, seed=experiment.seed, generation=1,
+                  method=experiment.method, substrate=substrate)
+    reference = [team_ft(champion.controller, champion.morphology, experiment.environment, s) for s in seeds]
+    assert ev.trial_ft == pytest.approx(reference)
+    assert ev.task == pytest.approx(sum(reference) / 4)
+
+
+def test_front_files_are_non_dominated(mo_run):
+    _, run = mo_run
+    points = [json.loads(f.read_text())["objectives"] for f in sorted((run / "front").glob("*.json"))]
+    assert points
+    for a, b in itertools.permutations(points, 2):            # brute force, both objectives maximised
+        dominates = (a["task"] >= b["task"] and a["morphology"] >= b["morphology"]
+                     and (a["task"] > b["task"] or a["morphology"] > b["morphology"]))
+        assert not dominates, (a, b)
+
+
+def front_files(run: Path) -> dict[str, dict]:
+    return {f.name: json.loads(f.read_text()) for f in sorted((run / "front").glob("*.json"))}
+
+
+def test_neat_m_mo_run_resumes_to_the_uninterrupted_result(mo_run, tmp_path):
+    exp, run = mo_run
+    copy = tmp_path / "copy"
+    shutil.copytree(run, copy)
+    shutil.rmtree(copy / "front")
+    evolve(exp, copy, "--resume-from", str(copy / "checkpoints" / "gen-0001.ckpt"))
+    assert without_timing(read_stats(copy / "stats.jsonl")) == without_timing(read_stats(run / "stats.jsonl"))
+    assert front_files(copy) == front_files(run)
+    assert json.loads((copy / "champion.json").read_text()) == json.loads((run / "champion.json").read_text())
+
+
+class ScriptedEvaluator:
+    """Gives genome 0 of generation g the task score ``scores[g]`` and every other genome 0."""
+
+    name = "scripted"
+
+    def __init__(self, scores):
+        self.scores = scores
+        self.failures = []
+
+    def map(self, genomes, generation):
+        empty = sensor_statistics(Morphology())
+        return [Evaluation(task=self.scores[generation] if i == 0 else 0.0, morphology=50.0, controller=50.0,
+                           sensors=empty) for i in range(len(genomes))]
+
+    def close(self):
+        pass
+
+
+@pytest.mark.parametrize("bonus, threshold", [(20.0, 110.0), (10.0, 105.0)])  # 100 + bonus / 2, by hand
+def test_so_convergence_stop_fires_exactly_at_the_threshold(tmp_path, monkeypatch, bonus, threshold):
+    exp = experiment_file(tmp_path, "so", "hyperneat-m", '["task"]', generations=6,
+                          extra="convergence_stop = true")
+    text = exp.read_text().replace("num_robots = 10", f"num_robots = 10\ntime_bonus = {bonus}")
+    exp.write_text(text)
+    scores = [threshold - 1e-9, threshold - 1e-6, threshold, threshold + 5, 0.0, 0.0]
+    monkeypatch.setattr(trainer_module, "make_evaluator", lambda *a, **k: ScriptedEvaluator(scores))
+    result = trainer_module.Trainer(load_experiment(exp), tmp_path / "run", workers=1, progress=False).run()
+    assert result.converged and result.generations == 3        # stopped right after generation 2
+    # the MO arm never stops early
+    mo = experiment_file(tmp_path, "mo", "hyperneat-m", '["task", "morphology"]', generations=4,
+                         extra="convergence_stop = true")
+    mo.write_text(mo.read_text().replace("num_robots = 10", f"num_robots = 10\ntime_bonus = {bonus}"))
+    result = trainer_module.Trainer(load_experiment(mo), tmp_path / "mo-run", workers=1, progress=False).run()
+    assert not result.converged and result.generations == 4
