@@ -6,6 +6,7 @@ Public names::
     SensorSpec, Morphology, SENSOR_TYPES  sensor suite description and per-type bounds
     morphological_complexity            paper eq. 2 (higher = simpler)
     WorldConfig, ENVIRONMENT_PRESETS    every world parameter, paper Table 2 presets
+    VectorSimulation                    W independent worlds stepped together (gathering_env.vector)
     __version__                         the version of the gathering-evolution distribution
 
 Importing the package registers ``gathering_env/CollectiveGathering-v0`` in PettingZoo's
@@ -23,6 +24,7 @@ from pettingzoo import register as _register
 from .config import ENVIRONMENT_PRESETS, WorldConfig
 from .env import GatheringEnv, env, parallel_env, raw_env
 from .sensors import SENSOR_TYPES, Morphology, SensorSpec, morphological_complexity
+from .vector import VectorSimulation
 
 ENV_ID = "gathering_env/CollectiveGathering-v0"
 TEAM_ENV_ID = "gathering_env/GatheringTeam-v0"
@@ -41,6 +43,7 @@ __all__ = [
     "GatheringEnv",
     "Morphology",
     "SensorSpec",
+    "VectorSimulation",
     "WorldConfig",
     "env",
     "morphological_complexity",

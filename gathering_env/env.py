@@ -39,6 +39,18 @@ value``. An episode's rewards therefore sum to the value part of the task perfor
 morphology=None, **world_parameters)``: ``environment`` picks the paper's block counts
 (1: 10/5/0, 2: 5/5/5, 3: 0/5/10); any field of ``WorldConfig`` can be overridden by
 keyword. ``reset(seed=..., options={"morphology": Morphology | list of sensor dicts})``.
+
+## Kernels
+``kernel="compiled"`` (default) computes everything of a step but pymunk's physics in numba
+kernels; ``kernel="numpy"`` uses the vectorised numpy reference. Both give the same
+episodes (tested bit for bit); the compiled one is several times faster (docs/performance.md).
+The first use of the compiled kernel in a fresh environment compiles it (a few seconds, once;
+the machine code is cached on disk, see ``gathering_env.kernels``).
+
+## Many worlds
+``gathering_env.vector.VectorSimulation(num_worlds, **world_parameters)`` steps W
+independent episodes together (arrays of shape (W, N, ...)); each world's episode is the
+one this env gives for the same seed.
 """
 
 from __future__ import annotations
