@@ -176,14 +176,14 @@ def test_whole_episodes_are_identical_on_both_kernels(world):
 
 def test_episode_that_terminates_early_is_identical():
     world = dict(SMALL, block_counts=(1, 0, 0), num_robots=15)
-    for seed in range(6):
-        ref, want = _episode("numpy", 3000, Morphology.khepera_iii(), seed, **world)
-        sim, got = _episode("compiled", 3000, Morphology.khepera_iii(), seed, **world)
+    finished = 0
+    for seed in (4, 0, 5):   # these end after 222 and 847 steps, and by truncation at 1000
+        ref, want = _episode("numpy", 1000, Morphology.khepera_iii(), seed, **world)
+        sim, got = _episode("compiled", 1000, Morphology.khepera_iii(), seed, **world)
         np.testing.assert_array_equal(np.asarray(got["pose"]), np.asarray(want["pose"]))
         assert (sim.steps, sim.task_performance()) == (ref.steps, ref.task_performance())
-    # at least one of these episodes ended by gathering everything (time bonus paid)
-    assert any(_episode("compiled", 3000, Morphology.khepera_iii(), s, **world)[0].task_performance() > 100
-               for s in range(6))
+        finished += sim.task_performance() > 100
+    assert finished == 2   # two episodes ended by gathering everything (time bonus paid)
 
 
 # ---------------------------------------------------------------------------- many worlds
