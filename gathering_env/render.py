@@ -262,7 +262,7 @@ def morphology_rows(morphology: Morphology) -> list[tuple[str, str, str, str, st
             rows.append((str(i), s.type, _degrees(s.bearing), "\u2013", "\u2013", "\u2013"))
         else:
             rows.append((str(i), s.type, _degrees(s.bearing), _degrees(s.orientation),
-                         f"{s.range:.1f}", f"{math.degrees(s.fov):.0f}\u00b0"))
+                         f"{s.range:.1f}" if s.range >= 0.95 else f"{s.range:.2g}", f"{math.degrees(s.fov):.0f}\u00b0"))
     return rows
 
 
