@@ -44,6 +44,7 @@ keyword. ``reset(seed=..., options={"morphology": Morphology | list of sensor di
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -109,6 +110,12 @@ class GatheringEnv(ParallelEnv):
         Every random choice (positions, headings) comes from ``seed``; with ``seed=None``
         the generator seeded at the previous reset continues.
         """
+        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer))):
+            raise TypeError(f"seed={seed!r} must be an integer >= 0 or None")
+        if seed is not None and seed < 0:
+            raise ValueError(f"seed={seed!r} out of range; allowed: an integer >= 0 or None")
+        if options is not None and not isinstance(options, Mapping):
+            raise TypeError(f"options={options!r} must be a dict (e.g. {{'morphology': ...}}) or None")
         if options:
             unknown = sorted(set(options) - {"morphology"}, key=str)
             if unknown:
@@ -135,6 +142,8 @@ class GatheringEnv(ParallelEnv):
             raise RuntimeError(
                 "step() called after the episode ended (or before reset()); call reset() first"
             )
+        if not isinstance(actions, Mapping):
+            raise TypeError(f"actions must be a dict {{agent: (left, right)}}; got {type(actions).__name__}")
         if actions.keys() != self._agent_index.keys():
             self._explain_action_keys(actions)
         try:
