@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .analysis import SELECTION_POINTS, Analysis  # noqa: E402
+from .guard import check_output_dir  # noqa: E402
 
 ENV_COLOURS = {1: "tab:blue", 2: "tab:orange", 3: "tab:red"}
 POINT_MARKERS = {"max": "^", "mean": "s", "knee": "D", "epsilon": "P"}
@@ -118,8 +119,20 @@ def figure6(analysis: Analysis, out: Path) -> Path:
     return path
 
 
+#: Every file ``write_report`` writes: the output folder may hold these (an earlier report,
+#: replaced) and nothing else.
+REPORT_FILES = ("table4.csv", "table4.md", "figure4_fronts.png", "figure5_simplicity.png", "figure6_points.png",
+                "report.md")
+
+
 def write_report(analysis: Analysis, out: Path) -> Path:
-    """All tables and figures plus ``report.md`` tying them together."""
+    """All tables and figures plus ``report.md`` tying them together.
+
+    ``out`` must be missing, empty or an earlier report (``REPORT_FILES`` only): other files
+    are never overwritten (``UsageError``).
+    """
+    out = Path(out)
+    check_output_dir(out, REPORT_FILES)
     out.mkdir(parents=True, exist_ok=True)
     table_md, table_csv = write_table4(analysis, out)
     figs = [figure4(analysis, out), figure5(analysis, out), figure6(analysis, out)]
