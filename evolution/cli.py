@@ -68,6 +68,9 @@ def evolve_main(argv: list[str] | None = None) -> int:
             raise UsageError(f"--resume {args.resume}: differs from --out {out}; allowed: one run directory "
                              "(--resume RUN_DIR alone)")
         out = args.resume
+    if args.resume_from is not None and args.resume_from.is_dir():
+        raise UsageError(f"--resume-from {args.resume_from}: is a folder; allowed: a checkpoint file "
+                         "(RUN_DIR/checkpoints/gen-NNNN.ckpt), or --resume RUN_DIR")
     if out is None and args.resume_from is not None:
         from .trainer import run_dir_of
 
@@ -115,7 +118,7 @@ def replay_main(argv: list[str] | None = None) -> int:
     parser.add_argument("champion", type=Path, help="champion JSON written by gathering-evolve")
     parser.add_argument("--environment", type=int, choices=(1, 2, 3), help="preset (default: the one it evolved in)")
     parser.add_argument("--steps", type=int_arg(1, 10**9), help="episode length (default: the evolved max_cycles)")
-    parser.add_argument("--seed", type=int_arg(0, 2**63 - 1), default=0)
+    parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0)
     parser.add_argument("--out", type=Path, default=Path("team.gif"), help=".gif or .mp4")
     parser.add_argument("--frame-every", type=int_arg(1, 10**9), default=10, help="record every k-th step")
     parser.add_argument("--fps", type=int_arg(1, 1000), default=15)

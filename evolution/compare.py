@@ -29,6 +29,7 @@ import numpy as np
 
 from gathering_env import Morphology, WorldConfig, parallel_env
 
+from .experiment import LIMITS
 from .guard import ArgumentParser, check_output_dir, command, int_arg
 
 
@@ -119,7 +120,7 @@ def make_policy(spec: str) -> Policy:
         return champion_policy(arg)
     if kind == "ppo" and arg:
         return ppo_policy(arg)
-    raise ValueError(f"policy {spec!r}; allowed: random, heuristic, champion:PATH, ppo:PATH")
+    raise ValueError(f"--policy {spec}: unknown policy; allowed: random, heuristic, champion:PATH, ppo:PATH")
 
 
 def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
@@ -210,7 +211,7 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--steps", type=int_arg(1, 10**9), default=10_000, help="max_cycles per episode")
     parser.add_argument("--robots", type=int_arg(1, 1000), default=20)
     parser.add_argument("--episodes", type=int_arg(1, 10_000), default=5, help="episodes (seeds 0..n-1) per policy")
-    parser.add_argument("--seed", type=int_arg(0, 2**63 - 1), default=0, help="first episode seed")
+    parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0, help="first episode seed")
     parser.add_argument("--out", type=Path, default=Path("compare"))
     args = parser.parse_args(argv)
     check_output_dir(args.out, COMPARE_FILES)

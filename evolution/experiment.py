@@ -130,12 +130,14 @@ def experiment_from_run(saved: dict[str, Any], source: str, overrides: dict[str,
         raise ExperimentError(f"{source}: the saved experiment is not a JSON object")
     section = {k: v for k, v in saved.items() if k in _EXPERIMENT_KEYS}
     if neat_config is not None:
-        section["neat_config"] = str(neat_config)
+        section["neat_config"] = str(Path(neat_config).resolve())
     raw = {"experiment": section, "environment": saved.get("environment"), "substrate": saved.get("substrate", {})}
-    return _validate(raw, source, CONFIG_DIR, overrides)
+    # a resumed run takes its neat config from the checkpoint: the file need not exist any more
+    return _validate(raw, source, CONFIG_DIR, overrides, need_neat_config=False)
 
 
-def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str, Any] | None) -> Experiment:
+def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str, Any] | None,
+              need_neat_config: bool = True) -> Experiment:
     unknown_sections = sorted(set(raw) - {"experiment", "environment", "substrate"})
     if unknown_sections:
         raise ExperimentError(
@@ -169,7 +171,7 @@ def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str,
     if not neat_path.is_absolute():
         candidates = [base / neat_path, CONFIG_DIR / neat_path]
         neat_path = next((p for p in candidates if p.exists()), candidates[0])
-    if not neat_path.exists():
+    if need_neat_config and not neat_path.is_file():
         raise ExperimentError(f"{source}: [experiment] neat_config: file {neat_path} not found")
     values["neat_config"] = neat_path
     try:

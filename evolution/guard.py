@@ -76,16 +76,18 @@ class ArgumentParser(argparse.ArgumentParser):
         sys.exit(2)
 
 
-def int_arg(low: int, high: int) -> Callable[[str], int]:
+def int_arg(low: int, high: float) -> Callable[[str], int]:
     """argparse type: an integer in [low, high]."""
+
+    allowed = f"an integer >= {low}" if high == float("inf") else f"{low}..{high}"
 
     def parse(text: str) -> int:
         try:
             value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not an integer; allowed: {low}..{high}") from None
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer; allowed: {allowed}") from None
         if not low <= value <= high:
-            raise argparse.ArgumentTypeError(f"{value} is out of range; allowed: {low}..{high}")
+            raise argparse.ArgumentTypeError(f"{value} is out of range; allowed: {allowed}")
         return value
 
     parse.__name__ = "integer"

@@ -68,7 +68,8 @@ def figure4(analysis: Analysis, out: Path) -> Path:
     ax.set_xlabel("morphological simplicity C (eq. 2)")
     ax.set_ylabel("task performance ft (eq. 1)")
     ax.set_title("Figure 4: MO fronts vs SO champions")
-    ax.legend(fontsize=7, loc="best")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="best")
     path = out / "figure4_fronts.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -89,7 +90,8 @@ def figure5(analysis: Analysis, out: Path) -> Path:
     ax.set_xlabel("generation")
     ax.set_ylabel("mean morphological simplicity C")
     ax.set_title("Figure 5: simplicity over generations")
-    ax.legend(fontsize=7)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7)
     path = out / "figure5_simplicity.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -112,7 +114,8 @@ def figure6(analysis: Analysis, out: Path) -> Path:
     ax.set_xticks(x + width * (len(envs) - 1) / 2, SELECTION_POINTS)
     ax.set_ylabel("morphological simplicity C")
     ax.set_title("Figure 6: simplicity per selection point")
-    ax.legend(fontsize=7)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7)
     path = out / "figure6_points.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)

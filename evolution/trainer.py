@@ -224,6 +224,7 @@ class Trainer:
         self.champion_state: dict[str, Any] | None = None  # what champion.json is written from
         self.records: list[dict[str, Any]] = []
         self.neat_cfg_text: str | None = None
+        self.finished = False  # set when a resumed run turns out to be complete already
         self._current: dict[int, Evaluation] = {}
 
     # ------------------------------------------------------------------ setup
@@ -285,25 +286,28 @@ class Trainer:
         population = state.get("population")
         if not isinstance(saved, dict) or not isinstance(population, neat.Population):
             raise CheckpointError(f"{path}: not a checkpoint of a gathering-evolve run")
+        recorded_path = self.run_dir / "experiment.json"
+        recorded = read_json(recorded_path, "experiment file", ExperimentError) if recorded_path.exists() else None
+        if recorded is not None:
+            for key in RUN_IDENTITY:
+                if not isinstance(recorded, dict) or recorded.get(key) != saved.get(key):
+                    raise ExperimentError(
+                        f"{recorded_path}: {key!r} differs from checkpoint {path} ({saved.get(key)!r}); the folder "
+                        "holds pieces of different runs; allowed: the run's own files (delete experiment.json to "
+                        "have it rebuilt from the checkpoint)")
         if self.experiment is None:
+            own = dict(saved)
+            if recorded is not None and "generations" in recorded:
+                own["generations"] = recorded["generations"]  # a run extended after this checkpoint
             own_cfg = self.run_dir / "neat.cfg"
-            self.experiment = experiment_from_run(saved, str(path), self.overrides,
-                                                  neat_config=own_cfg if own_cfg.is_file() else None)
+            self.experiment = experiment_from_run(own, str(recorded_path if recorded is not None else path),
+                                                  self.overrides, neat_config=own_cfg if own_cfg.is_file() else None)
         mine = self.experiment.to_dict()
         for key in RUN_IDENTITY:
             if saved.get(key) != mine.get(key):
                 raise ExperimentError(
                     f"{path}: resuming needs the same {key!r} as the run ({saved.get(key)!r}), got {mine.get(key)!r}"
                 )
-        recorded = self.run_dir / "experiment.json"
-        if recorded.exists():
-            doc = read_json(recorded, "experiment file", ExperimentError)
-            for key in RUN_IDENTITY:
-                if not isinstance(doc, dict) or doc.get(key) != saved.get(key):
-                    raise ExperimentError(
-                        f"{recorded}: {key!r} differs from checkpoint {path} ({saved.get(key)!r}); the folder holds "
-                        "pieces of different runs; allowed: the run's own files (delete experiment.json to have "
-                        "it rebuilt from the checkpoint)")
         records = state.get("records")
         if records is None:  # checkpoint of an older version: statistics only in stats.jsonl
             records = [r for r in read_stats(self.stats_path) if r.get("generation", -1) < population.generation]
@@ -316,28 +320,42 @@ class Trainer:
         if self.best is not None and not self.champion_path.exists() and self.champion_state is None:
             raise CheckpointError(f"{self.champion_path}: missing, and this (older) checkpoint {path.name} cannot "
                                   "rebuild it; allowed: the run's champion.json")
-        # Verified: from here on the run directory is written.
         self.config = population.config  # the exact config the lineage was evolved with
         self.substrate = substrate_for(self.experiment)
         self.neat_cfg_text = state.get("neat_cfg")
         population.config.pop_size = self.experiment.population
         random.setstate(state["random_state"])
         self.records = list(records)
+        # Verified. A finished run only gets its missing files back; a continued one is reset
+        # to the checkpoint (later generations will be recomputed identically).
+        self.finished = self._is_finished(population)
         self.run_dir.mkdir(parents=True, exist_ok=True)
-        if not recorded.exists() or read_json(recorded, "experiment file").get("generations") != \
-                self.experiment.generations:
-            recorded.write_text(json.dumps(self.experiment.to_dict(), indent=1) + "\n")
+        if recorded is None or (not self.finished and recorded.get("generations") != self.experiment.generations):
+            recorded_path.write_text(json.dumps(self.experiment.to_dict(), indent=1) + "\n")
         if not (self.run_dir / "neat.cfg").exists():
             if self.neat_cfg_text is not None:
                 (self.run_dir / "neat.cfg").write_text(self.neat_cfg_text, encoding="utf-8")
             else:
                 warnings.warn(f"{self.run_dir / 'neat.cfg'}: missing and this (older) checkpoint cannot rebuild it; "
                               "the run goes on with the config stored in the checkpoint", stacklevel=2)
-        # Statistics of generations after the checkpoint will be recomputed identically.
-        write_stats(self.stats_path, self.records)
-        if self.champion_state is not None and (not self.champion_path.exists() or self.resume_from is not None):
+        if not self.finished or not self.stats_path.exists():
+            write_stats(self.stats_path, self.records)
+        if self.champion_state is not None and (not self.champion_path.exists() or not self.finished):
             self._write_champion(**self.champion_state)
+        home = run_dir_of(path)
+        if home is None or home.resolve() != self.run_dir.resolve():
+            self._save_checkpoint(population)  # a run continued in a new folder resumes from there
         return population
+
+    def _is_finished(self, population: neat.Population) -> bool:
+        exp = self.experiment
+        return population.generation >= exp.generations or self._converged()
+
+    def _converged(self) -> bool:
+        exp = self.experiment
+        target = 100.0 + exp.world_config().time_bonus / 2.0
+        return bool(exp.convergence_stop and not exp.multi_objective and self.records
+                    and self.records[-1].get("task_best", 0.0) >= target)
 
     def _save_checkpoint(self, population: neat.Population) -> None:
         reporters = population.reporters
@@ -367,15 +385,14 @@ class Trainer:
         population = self._prepare()
         exp = self.experiment
         target = 100.0 + exp.world_config().time_bonus / 2.0
-        converged = bool(exp.convergence_stop and not exp.multi_objective and self.records
-                         and self.records[-1]["task_best"] >= target)
-        if converged or population.generation >= exp.generations:
+        if self.finished:
             # Nothing left to evolve: only rebuild what is missing.
             if exp.multi_objective and not any((self.run_dir / "front").glob("genome-*.json")):
                 self._write_front(population)
             if not (self.run_dir / "stats.png").exists():
                 self._plot()
-            return self._result(converged, already_finished=True)
+            return self._result(self._converged(), already_finished=True)
+        converged = False
         context = EvalContext(self.config, dict(exp.environment), exp.trials, exp.seed, exp.method, self.substrate)
         # Starting a backend (Ray in particular) may draw from Python's global random generator,
         # which is neat-python's: keep the lineage independent of the backend.

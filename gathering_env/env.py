@@ -56,6 +56,7 @@ from pettingzoo.utils.conversions import parallel_to_aec_wrapper
 from .config import WorldConfig
 from .sensors import Morphology
 from .simulation import GatheringSimulation, check_wheels
+from .world import GatheringWorld
 
 _ACTION_SPACE_BOUNDS = (-1.0, 1.0)
 
@@ -77,6 +78,7 @@ class GatheringEnv(ParallelEnv):
                 f"render_mode={render_mode!r}; allowed: None, {self.metadata['render_modes']}"
             )
         self.config = WorldConfig.from_kwargs(environment=environment, **world_parameters)
+        GatheringWorld.check_placement(self.config)  # an impossible world fails here, not at reset
         self.render_mode = render_mode
         self.morphology = Morphology.khepera_iii() if morphology is None else Morphology.coerce(morphology)
         self.sim = GatheringSimulation(self.config, self.morphology)
