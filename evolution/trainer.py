@@ -86,6 +86,10 @@ MAX_HIDDEN = 100
 """Upper bound of ``num_hidden`` (initial hidden nodes of every genome; the configs use 0)."""
 
 
+def _cppn_genome() -> type:
+    return genome_class("hyperneat-m")
+
+
 def check_neat_config(config: neat.Config, path: Path) -> None:
     """Rates, bounds and sizes of a neat-python config that neat-python itself accepts blindly.
 
@@ -120,6 +124,25 @@ def check_neat_config(config: neat.Config, path: Path) -> None:
             high = getattr(genome, key[: -len("_min_value")] + "_max_value", None)
             if number(high) and value > high:
                 raise bad(section, key, value, f"<= {key[: -len('_min_value')]}_max_value ({high})")
+    for gene, defs in (("activation", genome.activation_defs), ("aggregation", genome.aggregation_function_defs)):
+        options, default = getattr(genome, f"{gene}_options"), getattr(genome, f"{gene}_default")
+        if not options:
+            raise bad(section, f"{gene}_options", "(empty)", "one or more function names")
+        unknown = [name for name in options if not defs.is_valid(name)]
+        if unknown:
+            raise bad(section, f"{gene}_options", " ".join(options), f"names neat-python knows (not {unknown})")
+        if default not in options and default not in ("random", "none"):
+            raise bad(section, f"{gene}_default", default, f"random, none or one of {gene}_options")
+    if config.genome_type is not _cppn_genome():  # NEAT-M networks run on the team controller
+        from .controller import ACTIVATIONS
+
+        unknown = [name for name in genome.activation_options if name not in ACTIVATIONS]
+        if unknown:
+            raise bad(section, "activation_options", " ".join(genome.activation_options),
+                      f"functions of the team controller ({sorted(ACTIVATIONS)})")
+    for key, value in sorted(vars(genome).items()):
+        if key.endswith("_init_type") and value not in ("gaussian", "normal", "uniform"):
+            raise bad(section, key, value, "gaussian, normal or uniform")
     if not 0 <= genome.num_hidden <= MAX_HIDDEN:
         raise bad(section, "num_hidden", genome.num_hidden, f"0..{MAX_HIDDEN}")
     species = config.species_set_config
