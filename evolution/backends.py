@@ -15,6 +15,7 @@ from __future__ import annotations
 import multiprocessing
 import os
 import signal
+import socket
 import threading
 import time
 import traceback
@@ -196,6 +197,7 @@ class RayEvaluator:
             kwargs: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False,
                                       "configure_logging": False}
             if address:
+                _check_reachable(address)
                 kwargs["address"] = address
             elif num_cpus:
                 kwargs["num_cpus"] = num_cpus
@@ -224,6 +226,19 @@ class RayEvaluator:
     def close(self) -> None:
         if self._own and self._ray.is_initialized():
             self._ray.shutdown()
+
+
+def _check_reachable(address: str, timeout: float = 5.0) -> None:
+    """Fail fast for a ``host:port`` Ray address nobody listens on (Ray itself retries for minutes)."""
+    host, sep, port = address.removeprefix("ray://").rpartition(":")
+    if not sep or not port.isdigit():
+        return  # 'auto', 'local', ...: Ray resolves these itself
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout).close()
+    except (OSError, ValueError) as err:
+        raise ValueError(f"--ray-address {address}: cannot connect ({getattr(err, 'strerror', None) or err}); "
+                         "allowed: the address of a running Ray head node (ray start --head), or "
+                         "--backend process") from None
 
 
 def _ray_evaluate(context: EvalContext, genome: Any, generation: int) -> Evaluation:

@@ -248,6 +248,7 @@ class Trainer:
         self.records: list[dict[str, Any]] = []
         self.neat_cfg_text: str | None = None
         self.finished = False  # set when a resumed run turns out to be complete already
+        self._unwritten = False
         self._current: dict[int, Evaluation] = {}
 
     # ------------------------------------------------------------------ setup
@@ -261,11 +262,15 @@ class Trainer:
         self.substrate = substrate_for(exp)
         self.neat_cfg_text = Path(exp.neat_config).read_text(encoding="utf-8")
         population = neat.Population(self.config, seed=exp.seed)
+        self._unwritten = True  # written by _write_new_run once the backend has started
+        return population
+
+    def _write_new_run(self, population: neat.Population) -> None:
         self.run_dir.mkdir(parents=True, exist_ok=True)
-        (self.run_dir / "experiment.json").write_text(json.dumps(exp.to_dict(), indent=1) + "\n")
+        (self.run_dir / "experiment.json").write_text(json.dumps(self.experiment.to_dict(), indent=1) + "\n")
         (self.run_dir / "neat.cfg").write_text(self.neat_cfg_text, encoding="utf-8")
         self._save_checkpoint(population)
-        return population
+        self._unwritten = False
 
     def _checkpoints(self) -> list[Path]:
         return sorted((self.run_dir / CHECKPOINT_DIR).glob("gen-*.ckpt"))
@@ -307,7 +312,7 @@ class Trainer:
         path, state = self._find_checkpoint()
         saved = state.get("experiment")
         population = state.get("population")
-        if not isinstance(saved, dict) or not isinstance(population, neat.Population):
+        if not isinstance(saved, dict) or not isinstance(population, neat.Population) or "random_state" not in state:
             raise CheckpointError(f"{path}: not a checkpoint of a gathering-evolve run")
         recorded_path = self.run_dir / "experiment.json"
         recorded = read_json(recorded_path, "experiment file", ExperimentError) if recorded_path.exists() else None
@@ -423,6 +428,12 @@ class Trainer:
         evaluator = self._evaluator = make_evaluator(context, self.workers, self.backend, self.ray_address,
                                                      self.max_retries)
         random.setstate(random_state)
+        if self._unwritten:  # a new run: nothing is written before the backend is up
+            try:
+                self._write_new_run(population)
+            except BaseException:
+                evaluator.close()
+                raise
         previous_handlers = self._install_signal_handlers()
         bar = None
         if self.progress:

@@ -10,6 +10,7 @@ import math
 import os
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -265,6 +266,14 @@ def test_local_ray_that_fails_to_start_is_one_line(finished, tmp_path, capsys, m
     monkeypatch.setattr(ray, "is_initialized", lambda: False)
     assert evolve_main([str(exp), "--out", str(tmp_path / "r"), "--backend", "ray", "--no-progress"]) == 2
     assert "--backend ray: Ray did not start (second line)" in one_error_line(capsys)
+    assert not (tmp_path / "r").exists()                 # nothing written before the backend is up
+    with socket.socket() as s:                           # a port nobody listens on
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    assert evolve_main([str(exp), "--out", str(tmp_path / "r"), "--backend", "ray", "--ray-address",
+                        f"127.0.0.1:{port}", "--no-progress"]) == 2
+    assert f"--ray-address 127.0.0.1:{port}: cannot connect" in one_error_line(capsys)
+    assert not (tmp_path / "r").exists()
 
 
 @pytest.mark.parametrize("kwargs,error,needle", [
