@@ -256,8 +256,10 @@ class Trainer:
         if self.resume:
             return self._restore()
         exp = self.experiment
+        holds_run = (self.run_dir / CHECKPOINT_DIR).is_dir()
         check_output_dir(self.run_dir, what="run directory",
-                         hint=f"to continue the run in it: gathering-evolve --resume {self.run_dir}")
+                         hint=f"it holds a run: continue it with gathering-evolve --resume {self.run_dir}"
+                         if holds_run else "choose another --out")
         self.config = make_neat_config(exp)
         self.substrate = substrate_for(exp)
         self.neat_cfg_text = Path(exp.neat_config).read_text(encoding="utf-8")
