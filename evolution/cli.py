@@ -14,8 +14,9 @@ from pathlib import Path
 from .experiment import LIMITS, METHODS, load_experiment
 from .guard import ArgumentParser, UsageError, check_output_file, command, int_arg
 
-MAX_WORKERS = 1024
-"""Most evaluation processes/CPUs ``--workers`` may ask for."""
+MAX_WORKERS = max(4, 4 * (os.cpu_count() or 1))
+"""Most evaluation processes ``--workers`` may ask for: four per core (each worker holds its own
+environment, so more processes than cores only add memory)."""
 
 
 @command

@@ -500,3 +500,15 @@ def test_resume_from_another_runs_checkpoint_continues_into_a_new_folder(finishe
     assert clean_stats(branch) == clean_stats(run)
     assert snapshot(run) == before
     assert (branch / "checkpoints" / "gen-0003.ckpt").exists()
+
+
+def test_deleted_front_of_a_multi_objective_run_is_rebuilt(tmp_path):
+    exp = tmp_path / "mo.toml"
+    exp.write_text(TINY.format(generations=1).replace('seed = 5', 'seed = 5\nobjectives = ["task", "morphology"]'))
+    run = tmp_path / "run"
+    assert evolve_main([str(exp), "--out", str(run), "--workers", "1", "--no-progress"]) == 0
+    front = snapshot(run / "front")
+    assert front
+    shutil.rmtree(run / "front")
+    assert evolve_main(["--resume", str(run), "--no-progress"]) == 0
+    assert snapshot(run / "front") == front
