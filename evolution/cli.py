@@ -64,6 +64,8 @@ def evolve_main(argv: list[str] | None = None) -> int:
     }
     resume = args.resume is not None or args.resume_from is not None
     out = args.out
+    if args.resume is True and out is None and args.experiment is not None and args.experiment.is_dir():
+        out, args.experiment = args.experiment, None  # gathering-evolve RUN_DIR --resume
     if isinstance(args.resume, Path):
         if out is not None and out.resolve() != args.resume.resolve():
             raise UsageError(f"--resume {args.resume}: differs from --out {out}; allowed: one run directory "

@@ -105,7 +105,8 @@ def load_experiment(path: str | Path | None = None, overrides: dict[str, Any] | 
         path = Path(path)
         source = str(path)
         if path.is_dir():
-            raise ExperimentError(f"{path}: is a folder; allowed: a TOML experiment file (see configs/)")
+            hint = f" (it holds a run: continue it with --resume {path})" if (path / "checkpoints").is_dir() else ""
+            raise ExperimentError(f"{path}: is a folder; allowed: a TOML experiment file (see configs/){hint}")
         try:
             raw = tomllib.loads(path.read_text(encoding="utf-8"))
         except FileNotFoundError:
