@@ -18,6 +18,7 @@ The fast suite runs a modest, reproducible number of examples; ``-m slow`` runs 
 from __future__ import annotations
 
 import contextlib
+import copy
 import hashlib
 import io
 import json
@@ -166,12 +167,12 @@ def mutate_json(data, doc):
             if isinstance(doc[key], dict) and doc[key]:
                 target = doc[key]
         if not isinstance(target, dict) or not target:
-            return data.draw(st.sampled_from(JSON_VALUES), label="whole")
+            return copy.deepcopy(data.draw(st.sampled_from(JSON_VALUES), label="whole"))
         key = data.draw(st.sampled_from(sorted(target)), label="key")
         if data.draw(st.booleans(), label="delete"):
             del target[key]
         else:
-            target[key] = data.draw(st.sampled_from(JSON_VALUES), label="value")
+            target[key] = copy.deepcopy(data.draw(st.sampled_from(JSON_VALUES), label="value"))  # pool intact
     return doc
 
 
