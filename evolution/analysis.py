@@ -23,7 +23,8 @@ depend on the seeds. ``Analysis.scores`` says which were used.
 
 from __future__ import annotations
 
-import json
+import math
+import warnings
 from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +33,7 @@ from typing import Any
 import numpy as np
 from scipy import stats as sps
 
+from .champion import ChampionError, champion_objectives, read_json
 from .pareto import non_dominated_fronts
 from .stats import read_stats
 
@@ -55,30 +57,52 @@ class Run:
 
 
 def load_run(path: Path) -> Run:
-    """Read ``experiment.json``, ``stats.jsonl``, ``champion.json`` and ``front/*.json``."""
+    """Read ``experiment.json``, ``stats.jsonl``, ``champion.json`` and ``front/*.json``.
+
+    Raises ``ValueError`` naming the file for anything the analysis cannot use: a missing or
+    broken file, a record without the needed numbers, a champion (SO) or front (MO) that is
+    missing or has a non-finite objective.
+    """
     path = Path(path)
-    try:
-        experiment = json.loads((path / "experiment.json").read_text())
-    except FileNotFoundError:
-        raise ValueError(f"{path}: not a run directory (experiment.json missing)") from None
-    except json.JSONDecodeError as err:
-        raise ValueError(f"{path / 'experiment.json'}: not valid JSON: {err}") from None
-    env = int(experiment.get("environment", {}).get("environment") or 0)
-    multi = len(experiment.get("objectives", ["task"])) > 1
+    if not path.is_dir():
+        what = "is a file" if path.exists() else "does not exist"
+        raise ValueError(f"{path}: {what}; allowed: a run directory written by gathering-evolve")
+    if not (path / "experiment.json").exists():
+        raise ValueError(f"{path}: not a run directory (experiment.json missing); allowed: a run directory "
+                         "written by gathering-evolve (gathering-evolve --resume RUN_DIR rebuilds a deleted file)")
+    experiment = read_json(path / "experiment.json", "experiment file")
+    objectives = experiment.get("objectives", ["task"]) if isinstance(experiment, dict) else None
+    environment = experiment.get("environment", {}) if isinstance(experiment, dict) else None
+    if not isinstance(objectives, list) or not isinstance(environment, dict):
+        raise ValueError(f"{path / 'experiment.json'}: needs 'objectives' (a list) and 'environment' (an object)")
+    env = environment.get("environment") or 0
+    if isinstance(env, bool) or not isinstance(env, int):
+        raise ValueError(f"{path / 'experiment.json'}: environment.environment = {env!r}; allowed: 1, 2 or 3")
+    multi = len(objectives) > 1
     records = read_stats(path / "stats.jsonl")
     if not records:
-        raise ValueError(f"{path}: no statistics (stats.jsonl empty or missing)")
+        raise ValueError(f"{path / 'stats.jsonl'}: no statistics (empty or missing)")
+    for i, record in enumerate(records, 1):
+        for key in ("generation", "task_best", "morphology_mean"):
+            value = record.get(key)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError(f"{path / 'stats.jsonl'}: record {i} has {key} = {value!r}; allowed: a finite number")
     champion = None
     champ_file = path / "champion.json"
     if champ_file.exists():
-        obj = json.loads(champ_file.read_text())["objectives"]
-        champion = (float(obj["task"]), float(obj["morphology"]))
+        champion = _point(champ_file)
+    elif not multi:
+        raise ValueError(f"{champ_file}: missing; a single-objective run enters the analysis through its champion "
+                         "(gathering-evolve --resume RUN_DIR rebuilds it, or leave the run out)")
     points, files = [], []
     for f in sorted((path / "front").glob("*.json")):
-        obj = json.loads(f.read_text())["objectives"]
-        points.append((float(obj["task"]), float(obj["morphology"])))
+        points.append(_point(f))
         files.append(f.relative_to(path).as_posix())
-    return Run(path, experiment.get("name", path.name), env, multi, records, champion,
+    if multi and not points:
+        raise ValueError(f"{path / 'front'}: no front genomes; a multi-objective run enters the analysis through its "
+                         "final front (gathering-evolve --resume RUN_DIR rebuilds it, or leave the run out)")
+    name = experiment.get("name", path.name)
+    return Run(path, str(name), env, multi, records, champion,
                _non_dominated(np.array(points, dtype=float).reshape(-1, 2)), front_files=files)
 
 
@@ -95,6 +119,15 @@ def apply_reevaluation(run: Run, scores: dict[str, dict[str, Any]]) -> Run:
         points = [(float(scores[f]["task"]), float(scores[f]["morphology"])) for f in run.front_files]
         run.front = _non_dominated(np.array(points, dtype=float).reshape(-1, 2))
     return run
+
+
+def _point(path: Path) -> tuple[float, float]:
+    """(ft, C) of a champion or front file; needs finite 'task' and 'morphology' objectives."""
+    objectives = champion_objectives(path, read_json(path, "champion file", ChampionError))
+    if "morphology" not in objectives:
+        raise ChampionError(f"{path}: objectives.morphology is missing; allowed: an object with 'task' and "
+                            "'morphology'")
+    return objectives["task"], objectives["morphology"]
 
 
 def merge_fronts(fronts: list[np.ndarray]) -> np.ndarray:
@@ -184,12 +217,20 @@ def analyse(run_dirs: list[Path], reevaluate: int = 0, workers: int | None = Non
     """Load and compare all runs (see the module docstring).
 
     Args:
-        run_dirs: run directories. reevaluate: K held-out trials per champion and front
-            genome (0: use the training scores). workers, backend: evaluation backend.
+        run_dirs: run directories (the same directory given twice is counted once, with a
+            warning). reevaluate: K held-out trials per champion and front genome (0: use the
+            training scores). workers, backend: evaluation backend.
     """
     if reevaluate < 0:
         raise ValueError(f"reevaluate={reevaluate}; allowed: >= 0 (0 = training scores)")
-    runs = [load_run(p) for p in run_dirs]
+    unique: dict[Path, Path] = {}
+    for p in run_dirs:
+        key = Path(p).resolve()
+        if key in unique:
+            warnings.warn(f"{p}: the same run directory as {unique[key]}; counted once", stacklevel=2)
+        else:
+            unique[key] = Path(p)
+    runs = [load_run(p) for p in unique.values()]
     if reevaluate:
         from .reevaluate import reevaluate_run
 

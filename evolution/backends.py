@@ -15,6 +15,9 @@ from __future__ import annotations
 import multiprocessing
 import os
 import signal
+import socket
+import threading
+import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
@@ -84,14 +87,29 @@ class SerialEvaluator:
 
 
 _WORKER_CONTEXT: EvalContext | None = None
+ORPHAN_POLL_SECONDS = 0.5
+"""How often a pool worker checks that the process that started it is still alive."""
 
 
-def _init_worker(context: EvalContext) -> None:
+def _exit_when_orphaned(parent: int) -> None:
+    """Watchdog of a pool worker: exit as soon as ``parent`` is gone (e.g. SIGKILLed)."""
+    while True:
+        if os.getppid() != parent:
+            os._exit(1)
+        time.sleep(ORPHAN_POLL_SECONDS)
+
+
+def _init_worker(context: EvalContext, parent: int) -> None:
     global _WORKER_CONTEXT
     _WORKER_CONTEXT = context
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    # Ctrl-C reaches the whole process group: the trainer decides what to do, not the workers.
+    # Forked workers inherit the trainer's Python signal handlers: drop them. Ctrl-C reaches
+    # the whole process group and the trainer decides what to do, so workers ignore SIGINT;
+    # SIGTERM ends a worker at once.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    # A trainer killed with SIGKILL cannot shut its pool down: the workers notice on their own.
+    threading.Thread(target=_exit_when_orphaned, args=(parent,), name="orphan-watchdog", daemon=True).start()
 
 
 def _evaluate_in_worker(genome: Any, generation: int, attempt: int) -> Evaluation:
@@ -121,7 +139,7 @@ class ProcessEvaluator:
 
     def _new_pool(self) -> ProcessPoolExecutor:
         return ProcessPoolExecutor(max_workers=self.workers, mp_context=self._ctx,
-                                   initializer=_init_worker, initargs=(self.context,))
+                                   initializer=_init_worker, initargs=(self.context, os.getpid()))
 
     def map(self, genomes: list[Any], generation: int) -> list[Evaluation]:
         results: list[Evaluation | None] = [None] * len(genomes)
@@ -179,10 +197,17 @@ class RayEvaluator:
             kwargs: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False,
                                       "configure_logging": False}
             if address:
+                _check_reachable(address)
                 kwargs["address"] = address
             elif num_cpus:
                 kwargs["num_cpus"] = num_cpus
-            ray.init(**kwargs)
+            try:
+                ray.init(**kwargs)
+            except Exception as err:  # noqa: BLE001 - Ray raises many types when it cannot start
+                where = f"--ray-address {address}" if address else "--backend ray"
+                reason = (str(err).strip().splitlines() or [type(err).__name__])[-1]
+                raise ValueError(f"{where}: Ray did not start ({reason}); allowed: a reachable Ray cluster "
+                                 "address, or --backend process") from None
         self._context_ref = ray.put(context)
         self._task = ray.remote(_ray_evaluate).options(max_retries=max_retries, retry_exceptions=True)
 
@@ -201,6 +226,19 @@ class RayEvaluator:
     def close(self) -> None:
         if self._own and self._ray.is_initialized():
             self._ray.shutdown()
+
+
+def _check_reachable(address: str, timeout: float = 5.0) -> None:
+    """Fail fast for a ``host:port`` Ray address nobody listens on (Ray itself retries for minutes)."""
+    host, sep, port = address.removeprefix("ray://").rpartition(":")
+    if not sep or not port.isdigit():
+        return  # 'auto', 'local', ...: Ray resolves these itself
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=timeout).close()
+    except (OSError, ValueError) as err:
+        raise ValueError(f"--ray-address {address}: cannot connect ({getattr(err, 'strerror', None) or err}); "
+                         "allowed: the address of a running Ray head node (ray start --head), or "
+                         "--backend process") from None
 
 
 def _ray_evaluate(context: EvalContext, genome: Any, generation: int) -> Evaluation:

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from gathering_env import Morphology
+from gathering_env import Morphology, WorldConfig
 
 from .checkpoint import atomic_write_bytes
 
@@ -141,12 +141,7 @@ def load_champion(path: str | Path) -> Champion:
     from .controller import TeamController
 
     path = Path(path)
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ChampionError(f"{path}: champion file not found") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as err:
-        raise ChampionError(f"{path}: not valid JSON (truncated?): {err}") from None
+    doc = read_json(path, "champion file", ChampionError)
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
         raise ChampionError(f"{path}: field 'format' must be {FORMAT!r}")
     if doc.get("version") != VERSION:
@@ -154,17 +149,59 @@ def load_champion(path: str | Path) -> Champion:
     for key in ("method", "morphology", "controller", "objectives", "environment"):
         if key not in doc:
             raise ChampionError(f"{path}: field {key!r} is missing")
+    objectives = champion_objectives(path, doc)
+    if not isinstance(doc["environment"], dict):
+        raise ChampionError(f"{path}: field 'environment' must be an object of world parameters")
+    try:
+        WorldConfig.from_kwargs(**doc["environment"])
+    except (ValueError, TypeError) as err:
+        raise ChampionError(f"{path}: field 'environment': {err}") from None
+    for key in ("generation", "genome_key"):
+        if not isinstance(doc.get(key, -1), int) or isinstance(doc.get(key), bool):
+            raise ChampionError(f"{path}: field {key!r} is {doc.get(key)!r}; allowed: an integer")
     try:
         morphology = Morphology.from_dict(doc["morphology"])
-    except ValueError as err:
+    except (ValueError, TypeError, AttributeError) as err:
         raise ChampionError(f"{path}: field 'morphology': {err}") from None
     try:
         controller = TeamController.from_dict(doc["controller"])
-    except (ValueError, KeyError, TypeError) as err:
-        raise ChampionError(f"{path}: field 'controller': {err}") from None
+    except (ValueError, KeyError, TypeError, AttributeError, IndexError) as err:
+        raise ChampionError(f"{path}: field 'controller': {err!s}") from None
+    if controller.num_inputs != len(morphology):
+        raise ChampionError(f"{path}: field 'controller' reads {controller.num_inputs} inputs but the morphology "
+                            f"has {len(morphology)} sensors; allowed: one input per sensor")
     return Champion(
-        method=doc["method"], morphology=morphology, controller=controller,
-        objectives=dict(doc["objectives"]), environment=dict(doc["environment"]),
-        experiment=doc.get("experiment", ""), generation=int(doc.get("generation", -1)),
-        genome_key=int(doc.get("genome_key", -1)), genome=doc.get("genome"),
+        method=str(doc["method"]), morphology=morphology, controller=controller,
+        objectives=objectives, environment=dict(doc["environment"]),
+        experiment=str(doc.get("experiment", "")), generation=doc.get("generation", -1),
+        genome_key=doc.get("genome_key", -1), genome=doc.get("genome"),
     )
+
+
+def read_json(path: Path, what: str, error: type[ValueError] = ValueError) -> Any:
+    """Parse a JSON file; every failure raises ``error`` naming the file."""
+    path = Path(path)
+    if path.is_dir():
+        raise error(f"{path}: is a folder; allowed: a {what} (JSON)")
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise error(f"{path}: {what} not found") from None
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as err:
+        raise error(f"{path}: not valid JSON (truncated?): {err}") from None
+
+
+def champion_objectives(path: Path, doc: Any) -> dict[str, float]:
+    """The finite objective values of a champion document (``task`` required)."""
+    objectives = doc.get("objectives") if isinstance(doc, dict) else None
+    if not isinstance(objectives, dict):
+        raise ChampionError(f"{path}: field 'objectives' is missing or not an object; allowed: "
+                            "{\"task\": ft, ...}")
+    values = {}
+    for key, value in objectives.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ChampionError(f"{path}: objectives.{key} = {value!r}; allowed: a finite number")
+        values[key] = float(value)
+    if "task" not in values:
+        raise ChampionError(f"{path}: objectives.task is missing; allowed: an object with 'task'")
+    return values

@@ -64,6 +64,8 @@ def load_checkpoint(path: Path) -> dict[str, Any]:
             other version, truncated/corrupt payload).
     """
     path = Path(path)
+    if path.is_dir():
+        raise CheckpointError(f"{path}: is a folder; allowed: a checkpoint file (RUN_DIR/checkpoints/gen-NNNN.ckpt)")
     try:
         blob = path.read_bytes()
     except FileNotFoundError:

@@ -1,21 +1,19 @@
 """Command-line entry points: ``gathering-evolve``, ``gathering-replay``, ``gathering-analyze``.
 
-Errors in input files (experiment TOML, neat config, checkpoint, champion) end with a
-one-line message naming the file and field and exit status 2; nothing already written is
-touched.
+Errors in options and input files (experiment TOML, neat config, checkpoint, champion) end
+with a one-line message naming the option, file or field and exit status 2 (``evolution.guard``);
+nothing already written is touched. See docs/guarantees.md.
 """
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 from pathlib import Path
 
-from .checkpoint import CheckpointError
 from .experiment import (
+    LIMITS,
     METHODS,
-    ExperimentError,
     is_preset_name,
     load_experiment,
     neat_config_names,
@@ -23,11 +21,11 @@ from .experiment import (
     preset_names,
     preset_path,
 )
+from .guard import ArgumentParser, UsageError, check_output_file, command, int_arg
 
-
-def _fail(message: str) -> int:
-    print(f"error: {message}", file=sys.stderr)
-    return 2
+MAX_WORKERS = max(4, 4 * (os.cpu_count() or 1))
+"""Most evaluation processes ``--workers`` may ask for: four per core (each worker holds its own
+environment, so more processes than cores only add memory)."""
 
 
 def _list_presets() -> int:
@@ -37,19 +35,16 @@ def _list_presets() -> int:
 
 
 def _dump_preset(name: str) -> int:
-    try:
-        path = preset_path(name, neat_configs=True)
-    except ExperimentError as err:
-        return _fail(f"--dump {err}")
-    sys.stdout.write(path.read_text(encoding="utf-8"))
+    sys.stdout.write(preset_path(name, neat_configs=True).read_text(encoding="utf-8"))
     return 0
 
 
+@command
 def evolve_main(argv: list[str] | None = None) -> int:
     """``gathering-evolve [PRESET | EXPERIMENT.toml] [overrides] --out RUN_DIR``."""
     from gathering_env import __version__
 
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="gathering-evolve",
         description="Co-evolve controllers and sensor morphologies of a robot team (HyperNEAT-M / NEAT-M).",
     )
@@ -61,22 +56,27 @@ def evolve_main(argv: list[str] | None = None) -> int:
                         help="print a preset's file (e.g. --dump S1 > my.toml) and exit")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("--out", type=Path, help="run directory (default: runs/<name>-seed<seed>)")
-    parser.add_argument("--workers", type=int, default=None, help="evaluation processes (default: all cores; 1 = serial)")
-    parser.add_argument("--resume", action="store_true", help="continue the run in --out from its newest checkpoint")
-    parser.add_argument("--resume-from", type=Path, help="continue from this checkpoint file")
+    parser.add_argument("--workers", type=int_arg(1, MAX_WORKERS), default=None,
+                        help="evaluation processes (default: all cores; 1 = serial)")
+    parser.add_argument("--resume", nargs="?", const=True, type=Path, metavar="RUN_DIR",
+                        help="continue a run from its newest readable checkpoint: RUN_DIR (or --out); without "
+                             "an experiment file the run's own experiment is used")
+    parser.add_argument("--resume-from", type=Path, metavar="CHECKPOINT",
+                        help="continue from this checkpoint, in its run directory or into a new --out")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--backend", choices=("serial", "process", "ray"), default="process",
                         help="where genomes are evaluated (default: process pool)")
     parser.add_argument("--ray-address", help="join this Ray cluster (e.g. 'auto' or 'head:6379') instead of a local Ray")
-    parser.add_argument("--max-retries", type=int, default=2, help="retries of a failing evaluation (default 2)")
+    parser.add_argument("--max-retries", type=int_arg(0, 100), default=2,
+                        help="retries of a failing evaluation (default 2)")
     group = parser.add_argument_group("overrides of the experiment file")
     group.add_argument("--name")
     group.add_argument("--method", choices=METHODS)
     group.add_argument("--objectives", help="comma-separated: task,morphology,controller")
-    group.add_argument("--seed", type=int)
-    group.add_argument("--generations", type=int)
-    group.add_argument("--population", type=int)
-    group.add_argument("--trials", type=int)
+    group.add_argument("--seed", type=int_arg(*LIMITS["seed"]))
+    group.add_argument("--generations", type=int_arg(*LIMITS["generations"]))
+    group.add_argument("--population", type=int_arg(*LIMITS["population"]))
+    group.add_argument("--trials", type=int_arg(*LIMITS["trials"]))
     group.add_argument("--environment", type=int, help="environment preset 1, 2 or 3")
     group.add_argument("--steps", type=int, help="steps per trial (max_cycles)")
     group.add_argument("--robots", type=int, help="team size (num_robots)")
@@ -84,41 +84,65 @@ def evolve_main(argv: list[str] | None = None) -> int:
     if args.list:
         return _list_presets()
     if args.dump is not None:
-        return _dump_preset(args.dump)
+        try:
+            return _dump_preset(args.dump)
+        except ValueError as err:
+            raise UsageError(f"--dump {err}") from None
+    if args.experiment is not None:
+        args.experiment = preset_path(args.experiment) if is_preset_name(args.experiment) else Path(args.experiment)
 
     overrides = {
         "name": args.name, "method": args.method, "seed": args.seed, "generations": args.generations,
         "population": args.population, "trials": args.trials,
-        "objectives": args.objectives.split(",") if args.objectives else None,
+        "objectives": [o.strip() for o in args.objectives.split(",")] if args.objectives is not None else None,
         "environment.environment": args.environment, "environment.max_cycles": args.steps,
         "environment.num_robots": args.robots,
     }
-    if args.workers is not None and args.workers < 1:
-        return _fail(f"--workers={args.workers}; allowed: >= 1")
-    if args.max_retries < 0:
-        return _fail(f"--max-retries={args.max_retries}; allowed: >= 0")
-    try:
-        experiment_file = args.experiment
-        if experiment_file is not None and is_preset_name(experiment_file):
-            experiment_file = preset_path(experiment_file)
-        experiment = load_experiment(experiment_file, overrides)
-        out = args.out or Path("runs") / f"{experiment.name}-seed{experiment.seed}"
-        from .trainer import Trainer
+    resume = args.resume is not None or args.resume_from is not None
+    out = args.out
+    if args.resume is True and out is None and args.experiment is not None and args.experiment.is_dir():
+        out, args.experiment = args.experiment, None  # gathering-evolve RUN_DIR --resume
+    if isinstance(args.resume, Path):
+        if out is not None and out.resolve() != args.resume.resolve():
+            raise UsageError(f"--resume {args.resume}: differs from --out {out}; allowed: one run directory "
+                             "(--resume RUN_DIR alone)")
+        out = args.resume
+    if args.resume_from is not None and args.resume_from.is_dir():
+        raise UsageError(f"--resume-from {args.resume_from}: is a folder; allowed: a checkpoint file "
+                         "(RUN_DIR/checkpoints/gen-NNNN.ckpt), or --resume RUN_DIR")
+    if out is None and args.resume_from is not None:
+        from .trainer import run_dir_of
 
-        trainer = Trainer(experiment, out, workers=args.workers, resume=args.resume,
-                          resume_from=args.resume_from, progress=not args.no_progress,
-                          backend=args.backend, ray_address=args.ray_address, max_retries=args.max_retries)
+        out = run_dir_of(args.resume_from)
+        if out is None:
+            raise UsageError(f"--resume-from {args.resume_from}: not in a run's checkpoints/ folder; allowed: "
+                             "add --out NEW_DIR to continue it there")
+    if resume and out is None:
+        raise UsageError("--resume: which run? allowed: --resume RUN_DIR")
+    if resume and args.experiment is None:
+        experiment = None  # the run's own experiment, from its checkpoint
+    else:
+        experiment = load_experiment(args.experiment, overrides)
+        out = out or Path("runs") / f"{experiment.name}-seed{experiment.seed}"
+    from .trainer import Trainer
+
+    trainer = Trainer(experiment, out, workers=args.workers, resume=resume,
+                      resume_from=args.resume_from, progress=not args.no_progress,
+                      backend=args.backend, ray_address=args.ray_address, max_retries=args.max_retries,
+                      overrides=overrides)
+    try:
         result = trainer.run()
-    except (ExperimentError, CheckpointError) as err:
-        return _fail(str(err))
-    except ValueError as err:  # e.g. the ray backend without Ray installed
-        return _fail(str(err))
     except KeyboardInterrupt:
-        print("\ninterrupted: resume with --resume", file=sys.stderr)
+        print(f"\ninterrupted: resume with gathering-evolve --resume {out}", file=sys.stderr)
         return 130
     if result.interrupted:
-        print(f"stopped after {result.generations} generations; resume with: gathering-evolve ... --out {out} --resume")
+        print(f"stopped after {result.generations} generations; resume with: gathering-evolve --resume {out}")
         return 130
+    if result.already_finished:
+        why = "converged" if result.converged else f"reached its {trainer.experiment.generations} generations"
+        print(f"{out}: already finished ({why}: {result.generations} generations, best ft {result.best_task:.2f}); "
+              "nothing to evolve (raise --generations to continue it)")
+        return 0
     status = "converged" if result.converged else "finished"
     print(f"{status}: {result.generations} generations, best ft {result.best_task:.2f}")
     print(f"run directory: {result.run_dir}  (stats.jsonl, stats.csv, stats.png, champion.json, checkpoints/)")
@@ -131,33 +155,34 @@ _REPLAY_FLAGS = {"size_px": "--size", "cones": "--cones", "view": "--view", "tra
 """Render option (and replay argument) -> the ``gathering-replay`` flag that sets it."""
 
 
+@command
 def replay_main(argv: list[str] | None = None) -> int:
     """``gathering-replay CHAMPION.json [--environment N] [--out team.gif] [render options]``."""
-    parser = argparse.ArgumentParser(prog="gathering-replay",
-                                     description="Replay an evolved team and save the episode as GIF/MP4 "
-                                                 "(pictures: --png, --strip, --sensors-png; see docs/rendering.md).")
+    parser = ArgumentParser(prog="gathering-replay",
+                            description="Replay an evolved team and save the episode as GIF/MP4 "
+                                        "(pictures: --png, --strip, --sensors-png; see docs/rendering.md).")
     parser.add_argument("champion", type=Path, help="champion JSON written by gathering-evolve")
     parser.add_argument("--environment", type=int, choices=(1, 2, 3), help="preset (default: the one it evolved in)")
-    parser.add_argument("--steps", type=int, help="episode length (default: the evolved max_cycles)")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--steps", type=int_arg(1, 10**9), help="episode length (default: the evolved max_cycles)")
+    parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0)
     parser.add_argument("--out", type=Path, default=Path("team.gif"), help=".gif or .mp4")
-    parser.add_argument("--frame-every", type=int, default=10, help="record every k-th step")
-    parser.add_argument("--fps", type=int, default=15)
+    parser.add_argument("--frame-every", type=int_arg(1, 10**9), default=10, help="record every k-th step")
+    parser.add_argument("--fps", type=int_arg(1, 1000), default=15)
     parser.add_argument("--png", type=Path, help="also save the last frame (or with --strip a film strip) as PNG")
     look = parser.add_argument_group("what the frames show (docs/rendering.md)")
     look.add_argument("--cones", help="whose sensor cones: auto (default), all, none or robot indices like 0,3")
     look.add_argument("--view", help="full (default), zone, or follow:K to follow robot K")
-    look.add_argument("--size", type=int, help="side of the arena view in pixels (default 640)")
-    look.add_argument("--trail", type=int, help="draw each robot's path over its last K steps (default 0)")
+    look.add_argument("--size", type=int_arg(1, 100_000), help="side of the arena view in pixels (default 640)")
+    look.add_argument("--trail", type=int_arg(0, 10**9), help="draw each robot's path over its last K steps (default 0)")
     look.add_argument("--no-panel", action="store_true", help="no information panel beside the arena")
-    look.add_argument("--min-robot-px", type=int, help="smallest robot radius in pixels (default 4)")
+    look.add_argument("--min-robot-px", type=int_arg(0, 10_000), help="smallest robot radius in pixels (default 4)")
     look.add_argument("--strip", help="with --png: film strip of the frames at these steps, e.g. 0,600,1200")
     look.add_argument("--sensors-png", type=Path, help="also save the team's sensor layout (like the paper's Figure 3)")
     args = parser.parse_args(argv)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     from gathering_env.render import RenderOptionError
 
-    from .champion import ChampionError, load_champion
+    from .champion import load_champion
     from .replay import replay
 
     render_options = {name: value for name, value in (
@@ -165,23 +190,22 @@ def replay_main(argv: list[str] | None = None) -> int:
         ("min_robot_px", args.min_robot_px)) if value is not None}
     if args.no_panel:
         render_options["panel"] = False
-
+    check_output_file(args.out, (".gif", ".mp4"), "--out")
+    for picture, flag in ((args.png, "--png"), (args.sensors_png, "--sensors-png")):
+        if picture is not None:
+            check_output_file(picture, (".png",), flag)
+    champion = load_champion(args.champion)
+    env_config = dict(champion.environment)
+    if args.environment is not None:
+        env_config["environment"] = args.environment
+    if args.steps is not None:
+        env_config["max_cycles"] = args.steps
     try:
-        champion = load_champion(args.champion)
-        env_config = dict(champion.environment)
-        if args.environment is not None:
-            env_config["environment"] = args.environment
-        if args.steps is not None:
-            env_config["max_cycles"] = args.steps
         info, path, frames = replay(champion, env_config, args.seed, args.out, args.frame_every, args.fps,
                                     png=args.png, render_options=render_options, strip=args.strip,
                                     sensors_png=args.sensors_png)
-    except ChampionError as err:
-        return _fail(str(err))
     except RenderOptionError as err:
-        return _fail(f"{_REPLAY_FLAGS.get(err.option, err.option)}: {err.problem}; allowed: {err.allowed}")
-    except ValueError as err:
-        return _fail(str(err))
+        raise UsageError(f"{_REPLAY_FLAGS.get(err.option, err.option)}: {err.problem}; allowed: {err.allowed}") from None
     print(f"{champion.experiment or 'champion'} ({champion.method}, {len(champion.morphology)} sensors) in "
           f"environment {env_config.get('environment')}: ft = {info['task_performance']:.2f}, gathered "
           f"{info['gathered_value']:.0f}/{info['total_value']:.0f} in {info['steps']} steps")
@@ -192,39 +216,34 @@ def replay_main(argv: list[str] | None = None) -> int:
     return 0
 
 
+@command
 def analyze_main(argv: list[str] | None = None) -> int:
     """``gathering-analyze RUN_DIR... --out report/``."""
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="gathering-analyze",
         description="Merge MO fronts, compute selection points and SO-vs-MO tests; write Table 4, "
                     "Figures 4-6 and report.md.",
     )
     parser.add_argument("runs", nargs="+", type=Path, help="run directories written by gathering-evolve")
     parser.add_argument("--out", type=Path, default=Path("report"), help="output directory (default: report/)")
+    from .backends import BACKENDS
     from .reevaluate import REEVALUATE_TRIALS
 
-    parser.add_argument("--reevaluate", type=int, default=REEVALUATE_TRIALS, metavar="K",
+    parser.add_argument("--reevaluate", type=int_arg(0, 100_000), default=REEVALUATE_TRIALS, metavar="K",
                         help="re-run every SO champion and MO front genome K times on held-out seeds and report "
                              f"those scores (default {REEVALUATE_TRIALS}; cached in each run directory); "
                              "0 = use the training scores")
-    parser.add_argument("--workers", type=int, default=None,
+    parser.add_argument("--workers", type=int_arg(1, MAX_WORKERS), default=None,
                         help="evaluation processes for --reevaluate (default: all cores; 1 = serial)")
-    parser.add_argument("--backend", default="process", help="serial, process or ray (default: process)")
+    parser.add_argument("--backend", choices=BACKENDS, default="process",
+                        help="where --reevaluate runs (default: process pool)")
     args = parser.parse_args(argv)
     from .analysis import analyse
-    from .backends import BACKENDS
-    from .report import write_report
+    from .guard import check_output_dir
+    from .report import REPORT_FILES, write_report
 
-    if args.reevaluate < 0:
-        return _fail(f"--reevaluate={args.reevaluate}; allowed: an integer >= 0 (0 = training scores)")
-    if args.workers is not None and args.workers < 1:
-        return _fail(f"--workers={args.workers}; allowed: >= 1")
-    if args.backend not in BACKENDS:
-        return _fail(f"--backend={args.backend!r}; allowed: {', '.join(BACKENDS)}")
-    try:
-        analysis = analyse(args.runs, reevaluate=args.reevaluate, workers=args.workers, backend=args.backend)
-    except ValueError as err:
-        return _fail(str(err))
+    check_output_dir(args.out, REPORT_FILES)
+    analysis = analyse(args.runs, reevaluate=args.reevaluate, workers=args.workers, backend=args.backend)
     path = write_report(analysis, args.out)
     print(f"{len(analysis.runs)} runs, {len(analysis.comparisons)} comparisons -> {path}")
     print(f"ft used: {analysis.scores}")

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import json
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,7 +27,10 @@ from typing import Any
 
 import numpy as np
 
-from gathering_env import Morphology, parallel_env
+from gathering_env import Morphology, WorldConfig, parallel_env
+
+from .experiment import LIMITS
+from .guard import ArgumentParser, check_output_dir, command, int_arg
 
 
 @dataclass
@@ -77,13 +79,23 @@ def ppo_policy(path: str) -> Policy:
         from stable_baselines3 import PPO
     except ImportError:
         raise ValueError("ppo policies need Stable-Baselines3: pip install 'gathering-evolution[rl]'") from None
+    from .champion import read_json
+
     model_path = Path(path)
-    if not model_path.exists():
-        raise ValueError(f"{model_path}: PPO model not found")
+    if not model_path.is_file():
+        raise ValueError(f"{model_path}: PPO model not found; allowed: a model .zip saved by Stable-Baselines3")
     morph_path = model_path.with_suffix(".morphology.json")
-    morphology = (Morphology.from_dict(json.loads(morph_path.read_text())) if morph_path.exists()
-                  else Morphology.khepera_iii())
-    model = PPO.load(str(model_path), device="cpu")
+    morphology = Morphology.khepera_iii()
+    if morph_path.exists():
+        try:
+            morphology = Morphology.coerce(read_json(morph_path, "morphology file"))
+        except ValueError as err:
+            raise ValueError(f"{morph_path}: {err}") from None
+    try:
+        model = PPO.load(str(model_path), device="cpu")
+    except Exception as err:  # noqa: BLE001 - SB3/zipfile/torch raise many types for a broken file
+        raise ValueError(f"{model_path}: not a readable Stable-Baselines3 PPO model ({type(err).__name__}: "
+                         f"{err}); allowed: a model .zip saved by PPO.save") from None
     expected = model.observation_space.shape
     if expected != (len(morphology),):
         raise ValueError(f"{model_path}: the policy expects observations of shape {expected}, but its morphology "
@@ -108,7 +120,7 @@ def make_policy(spec: str) -> Policy:
         return champion_policy(arg)
     if kind == "ppo" and arg:
         return ppo_policy(arg)
-    raise ValueError(f"policy {spec!r}; allowed: random, heuristic, champion:PATH, ppo:PATH")
+    raise ValueError(f"--policy {spec}: unknown policy; allowed: random, heuristic, champion:PATH, ppo:PATH")
 
 
 def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
@@ -151,12 +163,18 @@ def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]
     return rows
 
 
+#: Every file ``write_outputs`` writes: the output folder may hold these (an earlier
+#: comparison, replaced) and nothing else.
+COMPARE_FILES = ("compare.csv", "compare.md", "compare.png")
+
+
 def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Path, Path, Path]:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    check_output_dir(out, COMPARE_FILES)
     out.mkdir(parents=True, exist_ok=True)
     csv_path = out / "compare.csv"
     with open(csv_path, "w", newline="") as f:
@@ -183,25 +201,24 @@ def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Pa
     return md_path, csv_path, png_path
 
 
+@command
 def compare_main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="gathering-compare", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = ArgumentParser(prog="gathering-compare", description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--policy", action="append", required=True,
                         help="random | heuristic | champion:PATH | ppo:PATH (repeat)")
     parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3))
-    parser.add_argument("--steps", type=int, default=10_000, help="max_cycles per episode")
-    parser.add_argument("--robots", type=int, default=20)
-    parser.add_argument("--episodes", type=int, default=5, help="episodes (seeds 0..n-1) per policy")
-    parser.add_argument("--seed", type=int, default=0, help="first episode seed")
+    parser.add_argument("--steps", type=int_arg(1, 10**9), default=10_000, help="max_cycles per episode")
+    parser.add_argument("--robots", type=int_arg(1, 1000), default=20)
+    parser.add_argument("--episodes", type=int_arg(1, 10_000), default=5, help="episodes (seeds 0..n-1) per policy")
+    parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0, help="first episode seed")
     parser.add_argument("--out", type=Path, default=Path("compare"))
     args = parser.parse_args(argv)
-    try:
-        policies = [make_policy(p) for p in args.policy]
-        env_config = {"environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots}
-        rows = compare(policies, env_config, list(range(args.seed, args.seed + args.episodes)))
-    except ValueError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
+    check_output_dir(args.out, COMPARE_FILES)
+    env_config = {"environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots}
+    WorldConfig.from_kwargs(**env_config)
+    policies = [make_policy(p) for p in args.policy]
+    rows = compare(policies, env_config, list(range(args.seed, args.seed + args.episodes)))
     title = (f"environment {args.environment}, {args.robots} robots, {args.steps} steps, "
              f"{args.episodes} episodes (seeds {args.seed}..{args.seed + args.episodes - 1})")
     md, csv_path, png = write_outputs(rows, args.out, title)

@@ -90,6 +90,10 @@ class Layer:
         return out
 
 
+MAX_NODES = 100_000
+"""Most computed nodes a controller may have (a bound for files read from disk)."""
+
+
 class TeamController:
     """A feed-forward network over ``num_inputs`` sensor readings driving two wheels.
 
@@ -107,6 +111,12 @@ class TeamController:
         if self.outputs.shape != (2,):
             raise ValueError(f"a team controller has 2 outputs (left, right wheel); got {self.outputs.tolist()}")
         width = self.num_inputs + self.num_nodes
+        if not (0 <= self.num_inputs and 0 <= self.num_nodes <= MAX_NODES):
+            raise ValueError(f"num_inputs={self.num_inputs}, num_nodes={self.num_nodes}; allowed: >= 0 and "
+                             f"num_nodes <= {MAX_NODES}")
+        if ((self.outputs < self.num_inputs) | (self.outputs >= width)).any():
+            raise ValueError(f"outputs {self.outputs.tolist()} are not computed nodes; allowed: "
+                             f"{self.num_inputs}..{width - 1}")
         for layer in self.layers:
             if layer.weights.shape[1] > width or (layer.targets < self.num_inputs).any() or (layer.targets >= width).any():
                 raise ValueError("layer targets/weights do not fit the controller's inputs and nodes")

@@ -37,6 +37,7 @@ them (the description is the first comment line of the file).
 
 from __future__ import annotations
 
+import math
 import re
 import tomllib
 from dataclasses import asdict, dataclass, field, fields, replace
@@ -45,11 +46,20 @@ from pathlib import Path
 from typing import Any
 
 from gathering_env.config import WorldConfig
+from gathering_env.world import GatheringWorld
 
 METHODS = ("hyperneat-m", "neat-m")
 OBJECTIVES = ("task", "morphology", "controller")
 DEFAULT_NEAT_CONFIGS = {"hyperneat-m": "hyperneat_m.neat.cfg", "neat-m": "neat_m.neat.cfg"}
 PRESET_PACKAGE = "evolution.presets"
+
+
+#: Allowed ranges of the integer keys. The upper bounds stop a typo (population = 1500000)
+#: before it allocates towards the out-of-memory killer: 10 000 genomes of the shipped
+#: configs take about 150 MB (the paper uses 150).
+LIMITS: dict[str, tuple[int, float]] = {
+    "seed": (0, math.inf), "generations": (1, 100_000), "population": (2, 10_000), "trials": (1, 1_000),
+}
 
 
 class ExperimentError(ValueError):
@@ -168,18 +178,49 @@ def load_experiment(path: str | Path | None = None, overrides: dict[str, Any] | 
     if path is not None:
         path = Path(path)
         source = str(path)
+        if path.is_dir():
+            hint = f" (it holds a run: continue it with --resume {path})" if (path / "checkpoints").is_dir() else ""
+            raise ExperimentError(f"{path}: is a folder; allowed: a TOML experiment file (see configs/){hint}")
         try:
             raw = tomllib.loads(path.read_text(encoding="utf-8"))
         except FileNotFoundError:
             raise ExperimentError(f"{path}: experiment file not found") from None
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
             raise ExperimentError(f"{path}: not valid TOML: {err}") from None
+        if not raw:
+            raise ExperimentError(f"{path}: experiment file is empty; allowed: an [experiment] and/or "
+                                  "[environment] section (or no file at all for the built-in defaults)")
         base = path.resolve().parent
+    return _validate(raw, source, base, overrides)
+
+
+def experiment_from_run(saved: dict[str, Any], source: str, overrides: dict[str, Any] | None = None,
+                        neat_config: Path | None = None) -> Experiment:
+    """The experiment of a run from its ``experiment.json`` form (``Experiment.to_dict()``).
+
+    ``overrides`` as for ``load_experiment``; ``neat_config`` replaces the recorded neat
+    config path (the run's own copy). Raises ``ExperimentError`` naming ``source``.
+    """
+    if not isinstance(saved, dict):
+        raise ExperimentError(f"{source}: the saved experiment is not a JSON object")
+    section = {k: v for k, v in saved.items() if k in _EXPERIMENT_KEYS}
+    if neat_config is not None:
+        section["neat_config"] = str(Path(neat_config).resolve())
+    raw = {"experiment": section, "environment": saved.get("environment"), "substrate": saved.get("substrate", {})}
+    # a resumed run takes its neat config from the checkpoint: the file need not exist any more
+    return _validate(raw, source, CONFIG_DIR, overrides, need_neat_config=False)
+
+
+def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str, Any] | None,
+              need_neat_config: bool = True) -> Experiment:
     unknown_sections = sorted(set(raw) - {"experiment", "environment", "substrate"})
     if unknown_sections:
         raise ExperimentError(
             f"{source}: unknown section(s) {unknown_sections}; allowed: [experiment], [environment], [substrate]"
         )
+    for section in ("experiment", "environment", "substrate"):
+        if section in raw and not isinstance(raw[section], dict):
+            raise ExperimentError(f"{source}: {section} = {raw[section]!r}; allowed: a [{section}] table")
     exp_section = dict(raw.get("experiment", {}))
     env_section = dict(raw.get("environment", {"environment": 2, "max_cycles": 10_000}))
     sub_section = dict(raw.get("substrate", {}))
@@ -205,13 +246,24 @@ def load_experiment(path: str | Path | None = None, overrides: dict[str, Any] | 
     if not neat_path.is_absolute():
         candidates = [base / neat_path, CONFIG_DIR / neat_path]
         neat_path = next((p for p in candidates if p.exists()), candidates[0])
-    if not neat_path.exists():
+    if need_neat_config and not neat_path.is_file():
         raise ExperimentError(f"{source}: [experiment] neat_config: file {neat_path} not found")
     values["neat_config"] = neat_path
     try:
-        WorldConfig.from_kwargs(**env_section)
+        world = WorldConfig.from_kwargs(**env_section)
+        GatheringWorld.check_placement(world)  # an impossible world fails now, not in every evaluation
     except (ValueError, TypeError) as err:
         raise ExperimentError(f"{source}: [environment] {err}") from None
+    if sub_section and method == "hyperneat-m":
+        from .substrate import Substrate
+
+        try:
+            Substrate(**sub_section)
+        except (TypeError, ValueError) as err:
+            raise ExperimentError(f"{source}: [substrate] {err}") from None
+    elif sub_section:
+        raise ExperimentError(f"{source}: [substrate] is used by method 'hyperneat-m' only; allowed: no "
+                              f"[substrate] section for method {method!r}")
     values["environment"] = env_section
     values["substrate"] = sub_section
     return Experiment(**values)
@@ -237,10 +289,11 @@ def _check_key(source: str, key: str, value: Any) -> Any:
         if len(set(value)) != len(value):
             raise ExperimentError(f"{where}={value!r} lists an objective twice")
         return tuple(value)
-    if key in ("seed", "generations", "population", "trials"):
-        low = {"seed": 0, "generations": 1, "population": 2, "trials": 1}[key]
-        if isinstance(value, bool) or not isinstance(value, int) or value < low:
-            raise ExperimentError(f"{where}={value!r} must be an integer >= {low}")
+    if key in LIMITS:
+        low, high = LIMITS[key]
+        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+            allowed = f">= {low}" if high == math.inf else f"in [{low}, {high}]"
+            raise ExperimentError(f"{where}={value!r}; allowed: an integer {allowed}")
         return value
     if key == "convergence_stop":
         if not isinstance(value, bool):

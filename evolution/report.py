@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .analysis import SELECTION_POINTS, Analysis  # noqa: E402
+from .guard import check_output_dir  # noqa: E402
 
 ENV_COLOURS = {1: "tab:blue", 2: "tab:orange", 3: "tab:red"}
 POINT_MARKERS = {"max": "^", "mean": "s", "knee": "D", "epsilon": "P"}
@@ -67,7 +68,8 @@ def figure4(analysis: Analysis, out: Path) -> Path:
     ax.set_xlabel("morphological simplicity C (eq. 2)")
     ax.set_ylabel("task performance ft (eq. 1)")
     ax.set_title(f"Figure 4: MO fronts vs SO champions ({analysis.scores.split(':')[0]} ft)")
-    ax.legend(fontsize=7, loc="best")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="best")
     path = out / "figure4_fronts.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -88,7 +90,8 @@ def figure5(analysis: Analysis, out: Path) -> Path:
     ax.set_xlabel("generation")
     ax.set_ylabel("mean morphological simplicity C")
     ax.set_title("Figure 5: simplicity over generations")
-    ax.legend(fontsize=7)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7)
     path = out / "figure5_simplicity.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -111,15 +114,28 @@ def figure6(analysis: Analysis, out: Path) -> Path:
     ax.set_xticks(x + width * (len(envs) - 1) / 2, SELECTION_POINTS)
     ax.set_ylabel("morphological simplicity C")
     ax.set_title(f"Figure 6: simplicity per selection point ({analysis.scores.split(':')[0]} ft)")
-    ax.legend(fontsize=7)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7)
     path = out / "figure6_points.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
 
+#: Every file ``write_report`` writes: the output folder may hold these (an earlier report,
+#: replaced) and nothing else.
+REPORT_FILES = ("table4.csv", "table4.md", "figure4_fronts.png", "figure5_simplicity.png", "figure6_points.png",
+                "report.md")
+
+
 def write_report(analysis: Analysis, out: Path) -> Path:
-    """All tables and figures plus ``report.md`` tying them together."""
+    """All tables and figures plus ``report.md`` tying them together.
+
+    ``out`` must be missing, empty or an earlier report (``REPORT_FILES`` only): other files
+    are never overwritten (``UsageError``).
+    """
+    out = Path(out)
+    check_output_dir(out, REPORT_FILES)
     out.mkdir(parents=True, exist_ok=True)
     table_md, table_csv = write_table4(analysis, out)
     figs = [figure4(analysis, out), figure5(analysis, out), figure6(analysis, out)]

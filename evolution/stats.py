@@ -11,6 +11,7 @@ import io
 import json
 import math
 import os
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -63,23 +64,33 @@ def generation_record(generation: int, evaluations: Sequence[Evaluation], specie
 def read_stats(path: Path) -> list[dict[str, Any]]:
     """Records of a ``stats.jsonl`` file (empty list if it does not exist).
 
-    A final line cut short by a crash is ignored; any other unreadable line raises
-    ``ValueError`` naming the file and line.
+    A final line cut short by a crash is ignored with a warning naming the file; any other
+    unreadable line, or a line that is not a JSON object, raises ``ValueError`` naming the
+    file and line.
     """
     path = Path(path)
     if not path.exists():
         return []
-    lines = path.read_text(encoding="utf-8").splitlines()
+    if path.is_dir():
+        raise ValueError(f"{path}: is a folder; allowed: a stats.jsonl file")
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text file; allowed: one JSON object per line") from None
     records = []
     for i, line in enumerate(lines, 1):
         if not line.strip():
             continue
         try:
-            records.append(json.loads(line))
-        except json.JSONDecodeError:
-            if i == len(lines):
-                break  # torn last line of a killed run
+            record = json.loads(line)
+        except (json.JSONDecodeError, RecursionError):
+            if i == len(lines):  # torn last line of a killed run
+                warnings.warn(f"{path}: last line ({i}) is cut short (a killed run?); ignored it", stacklevel=2)
+                break
             raise ValueError(f"{path}: line {i} is not valid JSON") from None
+        if not isinstance(record, dict):
+            raise ValueError(f"{path}: line {i} is not a JSON object; allowed: one record per line")
+        records.append(record)
     return records
 
 

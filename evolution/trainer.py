@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import json
 import random
-import shutil
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -34,14 +34,17 @@ import neat
 from gathering_env import morphological_complexity as morphology_simplicity
 
 from .backends import EvalContext, make_evaluator
-from .champion import save_champion
+from .champion import read_json, save_champion
 from .checkpoint import CheckpointError, load_checkpoint, save_checkpoint
 from .evaluate import Evaluation, decode_genome
-from .experiment import Experiment, ExperimentError
+from .experiment import Experiment, ExperimentError, experiment_from_run
+from .guard import UsageError, check_output_dir, describe_os_error
 from .stats import append_stats, generation_record, read_stats, write_stats
 
 CHECKPOINT_DIR = "checkpoints"
 KEEP_CHECKPOINTS = 3
+#: What a resumed run must share with the run it continues (``generations`` may grow).
+RUN_IDENTITY = ("method", "objectives", "seed", "population", "trials", "environment", "substrate")
 
 
 def genome_class(method: str) -> type:
@@ -77,9 +80,94 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
                              neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
     except Exception as err:  # neat raises several error types for broken files
         raise ExperimentError(f"{path}: invalid neat-python config: {err}") from None
+    check_neat_config(config, path)
     config.pop_size = experiment.population
     config.no_fitness_termination = True  # the trainer decides when to stop
     return config
+
+
+MAX_HIDDEN = 100
+"""Upper bound of ``num_hidden`` (initial hidden nodes of every genome; the configs use 0)."""
+
+
+def _cppn_genome() -> type:
+    return genome_class("hyperneat-m")
+
+
+def check_neat_config(config: neat.Config, path: Path) -> None:
+    """Rates, bounds and sizes of a neat-python config that neat-python itself accepts blindly.
+
+    Probabilities and rates must lie in [0, 1] (a negative rate silently switches a mutation
+    off), powers, deviations and coefficients must be >= 0, every ``*_min_value`` <= its
+    ``*_max_value``, ``num_hidden`` <= ``MAX_HIDDEN``. Raises ``ExperimentError`` naming the
+    file, section and key.
+    """
+    def bad(section: str, key: str, value: Any, allowed: str) -> ExperimentError:
+        return ExperimentError(f"{path}: [{section}] {key} = {value}; allowed: {allowed}")
+
+    def number(value: Any) -> bool:
+        return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+    genome, section = config.genome_config, config.genome_type.__name__
+    for key, value in sorted(vars(genome).items()):
+        if not number(value):
+            continue
+        if key.endswith("_add") and key.startswith("enabled_rate_to_"):
+            total = genome.enabled_mutate_rate + value
+            if not 0.0 <= total <= 1.0:
+                raise bad(section, key, value, "enabled_mutate_rate + this in [0, 1]")
+        elif key.endswith(("_rate", "_prob")):
+            if not 0.0 <= value <= 1.0:
+                raise bad(section, key, value, "a probability in [0, 1]")
+        elif key.endswith(("_mutate_power", "_init_stdev", "_coefficient")):
+            if not 0.0 <= value < float("inf"):
+                raise bad(section, key, value, "a finite number >= 0")
+        elif key.endswith(("_min_value", "_max_value", "_init_mean")) and value != value:
+            raise bad(section, key, value, "a number")
+        if key.endswith("_min_value"):
+            high = getattr(genome, key[: -len("_min_value")] + "_max_value", None)
+            if number(high) and value > high:
+                raise bad(section, key, value, f"<= {key[: -len('_min_value')]}_max_value ({high})")
+    for gene, defs in (("activation", genome.activation_defs), ("aggregation", genome.aggregation_function_defs)):
+        options, default = getattr(genome, f"{gene}_options"), getattr(genome, f"{gene}_default")
+        if not options:
+            raise bad(section, f"{gene}_options", "(empty)", "one or more function names")
+        unknown = [name for name in options if not defs.is_valid(name)]
+        if unknown:
+            raise bad(section, f"{gene}_options", " ".join(options), f"names neat-python knows (not {unknown})")
+        if default not in options and default not in ("random", "none"):
+            raise bad(section, f"{gene}_default", default, f"random, none or one of {gene}_options")
+    if config.genome_type is not _cppn_genome():  # NEAT-M networks run on the team controller
+        from .controller import ACTIVATIONS
+
+        unknown = [name for name in genome.activation_options if name not in ACTIVATIONS]
+        if unknown:
+            raise bad(section, "activation_options", " ".join(genome.activation_options),
+                      f"functions of the team controller ({sorted(ACTIVATIONS)})")
+    for key, value in sorted(vars(genome).items()):
+        if key.endswith("_init_type") and value not in ("gaussian", "normal", "uniform"):
+            raise bad(section, key, value, "gaussian, normal or uniform")
+    if not 0 <= genome.num_hidden <= MAX_HIDDEN:
+        raise bad(section, "num_hidden", genome.num_hidden, f"0..{MAX_HIDDEN}")
+    species = config.species_set_config
+    if not 0.0 < species.compatibility_threshold < float("inf"):
+        raise bad("DefaultSpeciesSet", "compatibility_threshold", species.compatibility_threshold, "a number > 0")
+    stagnation = config.stagnation_config
+    if stagnation.species_fitness_func not in ("max", "min", "mean", "median"):
+        raise bad("DefaultStagnation", "species_fitness_func", stagnation.species_fitness_func,
+                  "max, min, mean or median")
+    if stagnation.max_stagnation < 1:
+        raise bad("DefaultStagnation", "max_stagnation", stagnation.max_stagnation, "an integer >= 1")
+    if stagnation.species_elitism < 0:
+        raise bad("DefaultStagnation", "species_elitism", stagnation.species_elitism, "an integer >= 0")
+    reproduction = config.reproduction_config
+    if config.reproduction_type is neat.DefaultReproduction:
+        if reproduction.elitism < 0:
+            raise bad("DefaultReproduction", "elitism", reproduction.elitism, "an integer >= 0")
+        if not 0.0 < reproduction.survival_threshold <= 1.0:
+            raise bad("DefaultReproduction", "survival_threshold", reproduction.survival_threshold, "(0, 1]")
+        if reproduction.min_species_size < 1:
+            raise bad("DefaultReproduction", "min_species_size", reproduction.min_species_size, "an integer >= 1")
 
 
 def substrate_for(experiment: Experiment) -> Any:
@@ -101,93 +189,207 @@ class RunResult:
     champion: Path | None
     converged: bool
     interrupted: bool = False
+    already_finished: bool = False
+
+
+class RunFailed(UsageError):
+    """The run cannot go on (every evaluation failed, the run directory became unwritable)."""
+
+
+def run_dir_of(checkpoint: Path) -> Path | None:
+    """The run directory a checkpoint file belongs to (``RUN/checkpoints/gen-NNNN.ckpt``), if any."""
+    checkpoint = Path(checkpoint)
+    return checkpoint.parent.parent if checkpoint.parent.name == CHECKPOINT_DIR else None
 
 
 class Trainer:
     """Evolve one experiment into ``run_dir``.
 
     Args:
-        experiment: the validated experiment. run_dir: output directory.
+        experiment: the validated experiment; None when resuming: the run's own experiment
+            (from its checkpoint) with ``overrides`` applied. run_dir: output directory.
         workers: evaluation processes (None = all local cores, 1 = serial).
-        resume: continue from the newest checkpoint in ``run_dir`` (or ``resume_from``).
+        resume: continue from the newest readable checkpoint in ``run_dir`` (or ``resume_from``).
         progress: show a progress bar with ETA (tqdm).
         backend: 'serial', 'process' or 'ray' (``evolution.backends``); ray_address: join this
             Ray cluster instead of starting a local one. max_retries: per failing evaluation.
+        overrides: as for ``load_experiment``, applied to the run's experiment when
+            ``experiment`` is None (only ``generations`` and ``name`` may differ from the run).
+
+    Output folder: a new run writes only into a missing or empty ``run_dir``. A resumed run
+    must verify (a readable checkpoint whose experiment matches ``experiment.json``, the
+    experiment and the overrides); deleted ``experiment.json``, ``neat.cfg``, ``stats.jsonl``
+    and ``champion.json`` are rebuilt from the checkpoint. ``resume_from`` a checkpoint of
+    another run directory continues that run into a missing or empty ``run_dir``. Anything
+    else raises ``UsageError`` before a file is written.
 
     SIGINT/SIGTERM: the first signal lets the current generation finish (its statistics and
     checkpoint are written) and then stops; a second one abandons the generation at once. Either
     way the run resumes from its last checkpoint.
     """
 
-    def __init__(self, experiment: Experiment, run_dir: Path, workers: int | None = None,
+    def __init__(self, experiment: Experiment | None, run_dir: Path, workers: int | None = None,
                  resume: bool = False, resume_from: Path | None = None, progress: bool = True,
-                 backend: str = "process", ray_address: str | None = None, max_retries: int = 2) -> None:
+                 backend: str = "process", ray_address: str | None = None, max_retries: int = 2,
+                 overrides: dict[str, Any] | None = None) -> None:
+        if experiment is None and not (resume or resume_from is not None):
+            raise ValueError("experiment=None needs resume=True (the run's own experiment)")
         self.experiment = experiment
         self.run_dir = Path(run_dir)
         self.workers = workers
         self.resume = resume or resume_from is not None
-        self.resume_from = resume_from
+        self.resume_from = Path(resume_from) if resume_from is not None else None
         self.progress = progress
         self.backend = backend
         self.ray_address = ray_address
         self.max_retries = max_retries
+        self.overrides = overrides
         self.stop_requested = False
         self.stats_path = self.run_dir / "stats.jsonl"
         self.champion_path = self.run_dir / "champion.json"
         self.best: tuple[float, int] | None = None  # (task, genome key)
+        self.champion_state: dict[str, Any] | None = None  # what champion.json is written from
+        self.records: list[dict[str, Any]] = []
+        self.neat_cfg_text: str | None = None
+        self.finished = False  # set when a resumed run turns out to be complete already
+        self._unwritten = False
         self._current: dict[int, Evaluation] = {}
 
     # ------------------------------------------------------------------ setup
     def _prepare(self) -> neat.Population:
-        exp = self.experiment
-        self.config = make_neat_config(exp)
-        self.substrate = substrate_for(exp)
         if self.resume:
             return self._restore()
-        if self.stats_path.exists() or (self.run_dir / CHECKPOINT_DIR).exists():
-            raise ExperimentError(
-                f"{self.run_dir}: already holds a run; pass --resume to continue it or choose another --out"
-            )
-        self.run_dir.mkdir(parents=True, exist_ok=True)
-        (self.run_dir / "experiment.json").write_text(json.dumps(exp.to_dict(), indent=1) + "\n")
-        shutil.copyfile(exp.neat_config, self.run_dir / "neat.cfg")
+        exp = self.experiment
+        holds_run = (self.run_dir / CHECKPOINT_DIR).is_dir()
+        check_output_dir(self.run_dir, what="run directory",
+                         hint=f"it holds a run: continue it with gathering-evolve --resume {self.run_dir}"
+                         if holds_run else "choose another --out")
+        self.config = make_neat_config(exp)
+        self.substrate = substrate_for(exp)
+        self.neat_cfg_text = Path(exp.neat_config).read_text(encoding="utf-8")
         population = neat.Population(self.config, seed=exp.seed)
-        self._save_checkpoint(population)
+        self._unwritten = True  # written by _write_new_run once the backend has started
         return population
+
+    def _write_new_run(self, population: neat.Population) -> None:
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        (self.run_dir / "experiment.json").write_text(json.dumps(self.experiment.to_dict(), indent=1) + "\n")
+        (self.run_dir / "neat.cfg").write_text(self.neat_cfg_text, encoding="utf-8")
+        self._save_checkpoint(population)
+        self._unwritten = False
 
     def _checkpoints(self) -> list[Path]:
         return sorted((self.run_dir / CHECKPOINT_DIR).glob("gen-*.ckpt"))
 
-    def _restore(self) -> neat.Population:
-        candidates = [self.resume_from] if self.resume_from else list(reversed(self._checkpoints()))
+    def _find_checkpoint(self) -> tuple[Path, dict[str, Any]]:
+        """The checkpoint to resume from, after checking the run directory (nothing written)."""
+        run_dir = self.run_dir
+        if self.resume_from is not None:
+            home = run_dir_of(self.resume_from)
+            if home is None or home.resolve() != run_dir.resolve():
+                # continuing another run's checkpoint: into a fresh folder only
+                check_output_dir(run_dir, what="run directory",
+                                 hint=f"--resume-from continues {self.resume_from} into a new folder, or into "
+                                      "the run directory it belongs to")
+            return self.resume_from, load_checkpoint(self.resume_from)
+        if not run_dir.exists():
+            raise UsageError(f"{run_dir}: does not exist; nothing to resume; allowed: an existing run directory "
+                             "(start a new run without --resume)")
+        if not run_dir.is_dir():
+            raise UsageError(f"{run_dir}: is a file; allowed: a run directory written by gathering-evolve")
+        candidates = list(reversed(self._checkpoints()))
         if not candidates:
-            raise CheckpointError(f"{self.run_dir / CHECKPOINT_DIR}: no checkpoint to resume from")
+            raise CheckpointError(f"{run_dir / CHECKPOINT_DIR}: no checkpoint to resume from; allowed: a run "
+                                  "directory with checkpoints/gen-NNNN.ckpt (this folder is left unchanged)")
         errors = []
         for path in candidates:
             try:
                 state = load_checkpoint(path)
-                break
             except CheckpointError as err:
-                if self.resume_from:
-                    raise
                 errors.append(str(err))  # fall back to the previous checkpoint
-        else:
-            raise CheckpointError("no readable checkpoint: " + "; ".join(errors))
-        saved = state["experiment"]
+                continue
+            if errors:
+                warnings.warn(f"{'; '.join(errors)}; resuming from the previous readable checkpoint {path.name} "
+                              f"(generation {state['population'].generation})", stacklevel=2)
+            return path, state
+        raise CheckpointError("no readable checkpoint: " + "; ".join(errors))
+
+    def _restore(self) -> neat.Population:
+        path, state = self._find_checkpoint()
+        saved = state.get("experiment")
+        population = state.get("population")
+        if not isinstance(saved, dict) or not isinstance(population, neat.Population) or "random_state" not in state:
+            raise CheckpointError(f"{path}: not a checkpoint of a gathering-evolve run")
+        recorded_path = self.run_dir / "experiment.json"
+        recorded = read_json(recorded_path, "experiment file", ExperimentError) if recorded_path.exists() else None
+        if recorded is not None:
+            for key in RUN_IDENTITY:
+                if not isinstance(recorded, dict) or recorded.get(key) != saved.get(key):
+                    raise ExperimentError(
+                        f"{recorded_path}: {key!r} differs from checkpoint {path} ({saved.get(key)!r}); the folder "
+                        "holds pieces of different runs; allowed: the run's own files (delete experiment.json to "
+                        "have it rebuilt from the checkpoint)")
+        if self.experiment is None:
+            own = dict(saved)
+            if recorded is not None and "generations" in recorded:
+                own["generations"] = recorded["generations"]  # a run extended after this checkpoint
+            own_cfg = self.run_dir / "neat.cfg"
+            self.experiment = experiment_from_run(own, str(recorded_path if recorded is not None else path),
+                                                  self.overrides, neat_config=own_cfg if own_cfg.is_file() else None)
         mine = self.experiment.to_dict()
-        for key in ("method", "objectives", "seed", "population", "trials", "environment", "substrate"):
+        for key in RUN_IDENTITY:
             if saved.get(key) != mine.get(key):
                 raise ExperimentError(
                     f"{path}: resuming needs the same {key!r} as the run ({saved.get(key)!r}), got {mine.get(key)!r}"
                 )
-        population: neat.Population = state["population"]
+        records = state.get("records")
+        if records is None:  # checkpoint of an older version: statistics only in stats.jsonl
+            records = [r for r in read_stats(self.stats_path) if r.get("generation", -1) < population.generation]
+            if len(records) != population.generation:
+                raise CheckpointError(
+                    f"{self.stats_path}: holds {len(records)} of the {population.generation} generations before "
+                    f"{path.name}, and this (older) checkpoint cannot rebuild them; allowed: the run's stats.jsonl")
+        self.best = state.get("best")
+        self.champion_state = state.get("champion")
+        if self.best is not None and not self.champion_path.exists() and self.champion_state is None:
+            raise CheckpointError(f"{self.champion_path}: missing, and this (older) checkpoint {path.name} cannot "
+                                  "rebuild it; allowed: the run's champion.json")
+        self.config = population.config  # the exact config the lineage was evolved with
+        self.substrate = substrate_for(self.experiment)
+        self.neat_cfg_text = state.get("neat_cfg")
         population.config.pop_size = self.experiment.population
         random.setstate(state["random_state"])
-        self.best = state["best"]
-        # Statistics of generations after the checkpoint will be recomputed identically.
-        records = [r for r in read_stats(self.stats_path) if r["generation"] < population.generation]
-        write_stats(self.stats_path, records)
+        self.records = list(records)
+        # Verified. A finished run only gets its missing files back; a continued one is reset
+        # to the checkpoint (later generations will be recomputed identically).
+        self.finished = self._is_finished(population)
+        self.run_dir.mkdir(parents=True, exist_ok=True)
+        if recorded is None or (not self.finished and recorded.get("generations") != self.experiment.generations):
+            recorded_path.write_text(json.dumps(self.experiment.to_dict(), indent=1) + "\n")
+        if not (self.run_dir / "neat.cfg").exists():
+            if self.neat_cfg_text is not None:
+                (self.run_dir / "neat.cfg").write_text(self.neat_cfg_text, encoding="utf-8")
+            else:
+                warnings.warn(f"{self.run_dir / 'neat.cfg'}: missing and this (older) checkpoint cannot rebuild it; "
+                              "the run goes on with the config stored in the checkpoint", stacklevel=2)
+        if not self.finished or not self.stats_path.exists():
+            write_stats(self.stats_path, self.records)
+        if self.champion_state is not None and (not self.champion_path.exists() or not self.finished):
+            self._write_champion(**self.champion_state)
+        home = run_dir_of(path)
+        if home is None or home.resolve() != self.run_dir.resolve():
+            self._save_checkpoint(population)  # a run continued in a new folder resumes from there
         return population
+
+    def _is_finished(self, population: neat.Population) -> bool:
+        exp = self.experiment
+        return population.generation >= exp.generations or self._converged()
+
+    def _converged(self) -> bool:
+        exp = self.experiment
+        target = 100.0 + exp.world_config().time_bonus / 2.0
+        return bool(exp.convergence_stop and not exp.multi_objective and self.records
+                    and self.records[-1].get("task_best", 0.0) >= target)
 
     def _save_checkpoint(self, population: neat.Population) -> None:
         reporters = population.reporters
@@ -198,6 +400,10 @@ class Trainer:
             "random_state": random.getstate(),
             "experiment": self.experiment.to_dict(),
             "best": self.best,
+            # enough to rebuild stats.jsonl, champion.json and neat.cfg if they are deleted
+            "records": self.records,
+            "champion": self.champion_state,
+            "neat_cfg": self.neat_cfg_text,
         }
         path = self.run_dir / CHECKPOINT_DIR / f"gen-{population.generation:04d}.ckpt"
         try:
@@ -210,8 +416,17 @@ class Trainer:
 
     # ------------------------------------------------------------------ loop
     def run(self) -> RunResult:
-        exp = self.experiment
         population = self._prepare()
+        exp = self.experiment
+        target = 100.0 + exp.world_config().time_bonus / 2.0
+        if self.finished:
+            # Nothing left to evolve: only rebuild what is missing.
+            if exp.multi_objective and not any((self.run_dir / "front").glob("genome-*.json")):
+                self._write_front(population)
+            if not (self.run_dir / "stats.png").exists():
+                self._plot()
+            return self._result(self._converged(), already_finished=True)
+        converged = False
         context = EvalContext(self.config, dict(exp.environment), exp.trials, exp.seed, exp.method, self.substrate)
         # Starting a backend (Ray in particular) may draw from Python's global random generator,
         # which is neat-python's: keep the lineage independent of the backend.
@@ -219,14 +434,18 @@ class Trainer:
         evaluator = self._evaluator = make_evaluator(context, self.workers, self.backend, self.ray_address,
                                                      self.max_retries)
         random.setstate(random_state)
+        if self._unwritten:  # a new run: nothing is written before the backend is up
+            try:
+                self._write_new_run(population)
+            except BaseException:
+                evaluator.close()
+                raise
         previous_handlers = self._install_signal_handlers()
         bar = None
         if self.progress:
             from tqdm import tqdm
 
             bar = tqdm(total=exp.generations, initial=population.generation, desc=exp.name, unit="gen")
-        converged = False
-        target = 100.0 + exp.world_config().time_bonus / 2.0
         try:
             while population.generation < exp.generations:
                 generation = population.generation
@@ -240,6 +459,7 @@ class Trainer:
                     front = population.reproduction.front
                     record["front"] = {"genomes": [k for k, _ in front], "objectives": [list(o) for _, o in front],
                                        "names": list(exp.objectives)}
+                self.records.append(record)
                 append_stats(self.stats_path, record)
                 self._save_checkpoint(population)
                 if bar is not None:
@@ -250,6 +470,9 @@ class Trainer:
                     break
                 if self.stop_requested:
                     break
+        except OSError as err:
+            raise RunFailed(f"{describe_os_error(err)}; the run stopped at generation {population.generation}: "
+                            f"fix it and continue with gathering-evolve --resume {self.run_dir}") from None
         finally:
             self._restore_signal_handlers(previous_handlers)
             evaluator.close()
@@ -258,10 +481,13 @@ class Trainer:
         if exp.multi_objective:
             self._write_front(population)
         self._plot()
-        records = read_stats(self.stats_path)
-        return RunResult(self.run_dir, len(records), max((r["task_best"] for r in records), default=0.0),
+        return self._result(converged, interrupted=self.stop_requested)
+
+    def _result(self, converged: bool, interrupted: bool = False, already_finished: bool = False) -> RunResult:
+        best = self.best[0] if self.best is not None else max((r["task_best"] for r in self.records), default=0.0)
+        return RunResult(self.run_dir, len(self.records), best,
                          self.champion_path if self.champion_path.exists() else None, converged,
-                         interrupted=self.stop_requested)
+                         interrupted=interrupted, already_finished=already_finished)
 
     def _install_signal_handlers(self) -> dict[int, Any]:
         import signal
@@ -297,6 +523,11 @@ class Trainer:
             with open(self.run_dir / "errors.log", "a", encoding="utf-8") as log:
                 log.write(f"generation {self._generation} genome {key}: {error}\n")
         self._failures = len(self._evaluator.failures)
+        if genomes and self._failures == len(genomes):
+            first = self._evaluator.failures[0][1]
+            raise RunFailed(f"{self.run_dir}: every evaluation of generation {self._generation} failed (first: "
+                            f"{first}; all in {self.run_dir / 'errors.log'}); the run stopped: fix the cause and "
+                            f"continue with gathering-evolve --resume {self.run_dir}")
         self._evaluator.failures.clear()
         for (key, g), ev in zip(genomes, evaluations):
             g.fitness = ev.task
@@ -312,7 +543,9 @@ class Trainer:
         best_task = self._current[best_key].task
         if self.best is None or best_task > self.best[0]:
             self.best = (best_task, best_key)
-            self._write_champion(generation, self._current_genomes[best_key], self._current[best_key])
+            self.champion_state = {"generation": generation, "genome": self._current_genomes[best_key],
+                                   "evaluation": self._current[best_key]}
+            self._write_champion(**self.champion_state)
         return record
 
     def _write_champion(self, generation: int, genome: Any, evaluation: Evaluation) -> None:
@@ -346,6 +579,5 @@ class Trainer:
     def _plot(self) -> None:
         from .plots import plot_run
 
-        records = read_stats(self.stats_path)
-        if records:
-            plot_run(records, self.run_dir / "stats.png", title=self.experiment.name)
+        if self.records:
+            plot_run(self.records, self.run_dir / "stats.png", title=self.experiment.name)

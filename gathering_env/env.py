@@ -62,6 +62,7 @@ one this env gives for the same seed.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 from dataclasses import asdict
 from typing import Any
 
@@ -75,6 +76,7 @@ from .config import WorldConfig
 from .render import RenderOptions
 from .sensors import Morphology
 from .simulation import GatheringSimulation, check_wheels
+from .world import GatheringWorld
 
 _ACTION_SPACE_BOUNDS = (-1.0, 1.0)
 
@@ -97,6 +99,7 @@ class GatheringEnv(ParallelEnv):
                 f"render_mode={render_mode!r}; allowed: None, {self.metadata['render_modes']}"
             )
         self.config = WorldConfig.from_kwargs(environment=environment, **world_parameters)
+        GatheringWorld.check_placement(self.config)  # an impossible world fails here, not at reset
         self.render_mode = render_mode
         if render_options is not None and not isinstance(render_options, dict):
             raise TypeError(f"render_options={render_options!r}; allowed: None or a dict of render options")
@@ -133,6 +136,12 @@ class GatheringEnv(ParallelEnv):
         Every random choice (positions, headings) comes from ``seed``; with ``seed=None``
         the generator seeded at the previous reset continues.
         """
+        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer))):
+            raise TypeError(f"seed={seed!r} must be an integer >= 0 or None")
+        if seed is not None and seed < 0:
+            raise ValueError(f"seed={seed!r} out of range; allowed: an integer >= 0 or None")
+        if options is not None and not isinstance(options, Mapping):
+            raise TypeError(f"options={options!r} must be a dict (e.g. {{'morphology': ...}}) or None")
         if options:
             unknown = sorted(set(options) - {"morphology"}, key=str)
             if unknown:
@@ -161,7 +170,7 @@ class GatheringEnv(ParallelEnv):
             raise RuntimeError(
                 "step() called after the episode ended (or before reset()); call reset() first"
             )
-        if not isinstance(actions, dict):
+        if not isinstance(actions, Mapping):
             raise TypeError(f"actions must be a dict {{agent: (left, right)}}; got {type(actions).__name__}")
         if actions.keys() != self._agent_index.keys():
             self._explain_action_keys(actions)

@@ -49,8 +49,8 @@ class GatheringTeamEnv(gymnasium.Env):
         self.observation_space = spaces.Box(0.0, 1.0, shape=(width,), dtype=np.float32)
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        obs, _ = self.team.reset(seed=seed, options=options)  # checks seed and options first
         super().reset(seed=seed)
-        obs, _ = self.team.reset(seed=seed, options=options)
         self._set_observation_space()
         return self._flatten(obs), self.team.team_info()
 

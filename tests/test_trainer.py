@@ -84,7 +84,8 @@ def test_existing_run_is_not_overwritten(serial_run, capsys):
     exp, run = serial_run
     before = (run / "stats.jsonl").read_bytes()
     assert evolve_main([str(exp), "--out", str(run), "--workers", "1", "--no-progress"]) == 2
-    assert "already holds a run" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "not empty" in err and f"--resume {run}" in err
     assert (run / "stats.jsonl").read_bytes() == before
 
 
