@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import functools
 import os
+import re
 import sys
 import warnings
 from collections.abc import Callable, Iterable
@@ -72,6 +73,9 @@ class ArgumentParser(argparse.ArgumentParser):
     """argparse, but a bad option prints one line ``error: ...`` (exit status 2)."""
 
     def error(self, message: str):  # type: ignore[override]
+        choice = re.fullmatch(r"argument (\S+): invalid choice: (.+) \(choose from (.+)\)", message)
+        if choice:
+            message = f"{choice[1]}: {choice[2]} is not a choice; allowed: {choice[3]}"
         fail(f"{message}; see {self.prog} --help")
         sys.exit(2)
 

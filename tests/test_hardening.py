@@ -358,7 +358,7 @@ def test_empty_objectives_option_is_refused(finished, tmp_path, capsys, value):
     ("weight_mutate_rate", "0.05", "-0.1", "weight_mutate_rate = -0.1; allowed: a probability in [0, 1]"),
     ("conn_add_prob", "0.005", "1.5", "conn_add_prob = 1.5"),
     ("weight_mutate_power", "0.5", "nan", "weight_mutate_power = nan"),
-    ("survival_threshold", "0.3", "0.0", "survival_threshold = 0.0; allowed: (0, 1]"),
+    ("parent_fraction", "0.3", "0.0", "parent_fraction=0.0; allowed: (0, 1]"),
     ("max_stagnation", "20", "0", "max_stagnation = 0"),
     ("num_hidden", "0", "100000", "num_hidden = 100000"),
 ])

@@ -73,8 +73,8 @@ def test_film_strip_panels_full_view(champion, tmp_path):
                                             "comma-separated steps in 0..40"),
     (["--strip", "0,a", "--png", "s.png"], "error: --strip: '0,a' is not a list of steps; allowed:"),
     (["--strip", "0,10"], "error: --strip: a film strip needs a picture file; allowed: --png FILE.png"),
-    (["--png", "s.jpg"], "error: --png: 's.jpg' has suffix '.jpg'; allowed: a .png file"),
-    (["--sensors-png", "s.gif"], "error: --sensors-png: 's.gif' has suffix '.gif'; allowed: a .png file"),
+    (["--png", "s.jpg"], "error: --png s.jpg: suffix '.jpg'; allowed: .png"),
+    (["--sensors-png", "s.gif"], "error: --sensors-png s.gif: suffix '.gif'; allowed: .png"),
 ])
 def test_bad_replay_options_exit_2_with_one_line(champion, tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)
