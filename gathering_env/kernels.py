@@ -353,6 +353,14 @@ def unpack(raw, robot_rows, block_rows, active, robot_pos, robot_angle, block_po
 
 
 @njit(cache=True)
+def _in_zone(x, y, angle, half, params):
+    """A block counts as gathered while its axis-aligned bounding box lies wholly in the zone."""
+    extent = half * (abs(math.cos(angle)) + abs(math.sin(angle)))
+    return ((x - extent >= params[P_ZX0]) and (x + extent <= params[P_ZX1])
+            and (y - extent >= params[P_ZY0]) and (y + extent <= params[P_ZY1]))
+
+
+@njit(cache=True)
 def gathered_blocks(block_pos, block_angle, block_half, params, active, gathered):
     """(W, B) bool in place: the block's bounding box lies wholly inside the zone."""
     n_worlds, n_blocks = block_angle.shape
@@ -360,12 +368,7 @@ def gathered_blocks(block_pos, block_angle, block_half, params, active, gathered
         if not active[w]:
             continue
         for b in range(n_blocks):
-            a = block_angle[w, b]
-            extent = block_half[b] * (abs(math.cos(a)) + abs(math.sin(a)))
-            x = block_pos[w, b, 0]
-            y = block_pos[w, b, 1]
-            gathered[w, b] = ((x - extent >= params[P_ZX0]) and (x + extent <= params[P_ZX1])
-                              and (y - extent >= params[P_ZY0]) and (y + extent <= params[P_ZY1]))
+            gathered[w, b] = _in_zone(block_pos[w, b, 0], block_pos[w, b, 1], block_angle[w, b], block_half[b], params)
 
 
 @njit(cache=True)
@@ -423,12 +426,7 @@ def settle(raw, robot_rows, block_rows, active, block_half, block_need, block_va
             reward[w] = 0.0
             continue
         for b in range(n_blocks):
-            a = block_angle[w, b]
-            extent = block_half[b] * (abs(math.cos(a)) + abs(math.sin(a)))
-            x = block_pos[w, b, 0]
-            y = block_pos[w, b, 1]
-            now[b] = ((x - extent >= params[P_ZX0]) and (x + extent <= params[P_ZX1])
-                      and (y - extent >= params[P_ZY0]) and (y + extent <= params[P_ZY1]))
+            now[b] = _in_zone(block_pos[w, b, 0], block_pos[w, b, 1], block_angle[w, b], block_half[b], params)
         if pickup:
             for i in range(n):
                 if robot_attached[w, i] >= 0:
