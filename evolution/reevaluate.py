@@ -62,15 +62,14 @@ def heldout_seeds(run_seed: int, generations: int, trials: int, k: int) -> list[
 
 def _run_setup(run_dir: Path) -> tuple[Any, Any, Any]:
     """(experiment, neat config, substrate) of a run directory, from its own copies."""
-    from .experiment import Experiment, ExperimentError
+    from .champion import read_json
+    from .experiment import ExperimentError, experiment_from_run
     from .trainer import make_neat_config, substrate_for
 
-    doc = json.loads((run_dir / "experiment.json").read_text())
-    doc.pop("source", None)
-    doc["objectives"] = tuple(doc.get("objectives", ("task",)))
-    doc["neat_config"] = run_dir / "neat.cfg"
+    path = run_dir / "experiment.json"
     try:
-        experiment = Experiment(**doc, source=str(run_dir / "experiment.json"))
+        experiment = experiment_from_run(read_json(path, "experiment file", ExperimentError), str(path),
+                                         neat_config=run_dir / "neat.cfg")
         config = make_neat_config(experiment)
     except (TypeError, ExperimentError) as err:
         raise ValueError(f"{run_dir}: cannot rebuild the run's configuration for re-evaluation ({err}); "
