@@ -1,6 +1,6 @@
 """Compare team policies on the same seeds: random, a fixed search pattern, evolved champions, PPO.
 
-``gathering-compare --policy random --policy heuristic --policy champion:run/champion.json
+``gathering-compare --policy random --policy heuristic --policy wander --policy champion:run/champion.json
 --policy ppo:ppo/model.zip --environment 2 --episodes 5 --out compare/`` runs every policy on
 the same environment and episode seeds and writes ``compare.md`` / ``compare.csv`` (mean +- std
 ft, blocks gathered by type, time to finish) and ``compare.png`` (a bar plot).
@@ -11,6 +11,9 @@ Policies (each carries the morphology it was made for):
 * ``heuristic``: the pickup heuristic with a fixed search pattern on Khepera III readings:
   drive forward on a slight curve, turn on the spot while the front ultrasonic or either
   infrared sensor reports an obstacle close ahead.
+* ``wander``: the speed benchmark's explorer (``gathering_env.policies.WanderTeam``): forward
+  at 0.8 of top speed with a drift redrawn every 50 steps, spin on the spot when the front
+  ultrasonic has read an obstacle very close for 20 steps (Khepera III morphology).
 * ``champion:PATH``: an evolved team from a champion JSON (its own morphology).
 * ``ppo:PATH``: a Stable-Baselines3 PPO model (``examples/rl_ppo.py``) with the morphology
   saved next to it (``PATH`` with suffix ``.morphology.json``), Khepera III if absent.
@@ -29,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from gathering_env import Morphology, parallel_env
+from gathering_env.policies import WanderTeam
 
 
 @dataclass
@@ -63,6 +67,12 @@ def heuristic_policy() -> Policy:
         return wheels
 
     return Policy("heuristic", Morphology.khepera_iii(), act)
+
+
+def wander_policy() -> Policy:
+    """The benchmark's explorer (``gathering_env.policies.WanderTeam``) on Khepera III."""
+    team = WanderTeam(Morphology.khepera_iii())
+    return Policy("wander", team.morphology, team.act, team.reset)
 
 
 def champion_policy(path: str) -> Policy:
@@ -104,11 +114,13 @@ def make_policy(spec: str) -> Policy:
         return random_policy()
     if kind == "heuristic" and not arg:
         return heuristic_policy()
+    if kind == "wander" and not arg:
+        return wander_policy()
     if kind == "champion" and arg:
         return champion_policy(arg)
     if kind == "ppo" and arg:
         return ppo_policy(arg)
-    raise ValueError(f"policy {spec!r}; allowed: random, heuristic, champion:PATH, ppo:PATH")
+    raise ValueError(f"policy {spec!r}; allowed: random, heuristic, wander, champion:PATH, ppo:PATH")
 
 
 def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
@@ -187,7 +199,7 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="gathering-compare", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--policy", action="append", required=True,
-                        help="random | heuristic | champion:PATH | ppo:PATH (repeat)")
+                        help="random | heuristic | wander | champion:PATH | ppo:PATH (repeat)")
     parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3))
     parser.add_argument("--steps", type=int, default=10_000, help="max_cycles per episode")
     parser.add_argument("--robots", type=int, default=20)
