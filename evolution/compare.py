@@ -16,7 +16,10 @@ Policies (each carries the morphology it was made for):
   ultrasonic has read an obstacle very close for 20 steps (Khepera III morphology).
 * ``champion:PATH``: an evolved team from a champion JSON (its own morphology).
 * ``ppo:PATH``: a Stable-Baselines3 PPO model (``examples/rl_ppo.py``) with the morphology
-  saved next to it (``PATH`` with suffix ``.morphology.json``), Khepera III if absent.
+  saved next to it (``PATH`` with suffix ``.morphology.json``), Khepera III if absent; its
+  deterministic actions (the policy's mean).
+* ``ppo-sample:PATH``: the same model with actions sampled from its distribution, as in
+  training (torch's generator seeded by the episode seed).
 """
 
 from __future__ import annotations
@@ -82,7 +85,9 @@ def champion_policy(path: str) -> Policy:
     return Policy(f"champion:{Path(path).parent.name or path}", champion.morphology, champion.controller.act)
 
 
-def ppo_policy(path: str) -> Policy:
+def ppo_policy(path: str, sample: bool = False) -> Policy:
+    """A saved SB3 model; deterministic actions (the policy's mean), or with ``sample`` actions
+    drawn from the policy's distribution (torch's generator seeded by the episode seed)."""
     try:
         from stable_baselines3 import PPO
     except ImportError:
@@ -100,12 +105,18 @@ def ppo_policy(path: str) -> Policy:
                          f"has {len(morphology)} sensors; save the morphology as {morph_path.name}")
 
     def act(obs):
-        action, _ = model.predict(obs.astype(np.float32), deterministic=True)
+        action, _ = model.predict(obs.astype(np.float32), deterministic=not sample)
         return np.asarray(action, dtype=np.float64).reshape(obs.shape[0], 2)
+
+    def reset(seed):
+        if sample:
+            import torch
+
+            torch.manual_seed(seed)
 
     # SB3 saves "model.zip" by default: name such a model after its run directory instead.
     label = model_path.parent.name if model_path.stem == "model" and model_path.parent.name else model_path.stem
-    return Policy(f"ppo:{label}", morphology, act)
+    return Policy(f"{'ppo-sample' if sample else 'ppo'}:{label}", morphology, act, reset)
 
 
 def make_policy(spec: str) -> Policy:
@@ -118,9 +129,9 @@ def make_policy(spec: str) -> Policy:
         return wander_policy()
     if kind == "champion" and arg:
         return champion_policy(arg)
-    if kind == "ppo" and arg:
-        return ppo_policy(arg)
-    raise ValueError(f"policy {spec!r}; allowed: random, heuristic, wander, champion:PATH, ppo:PATH")
+    if kind in ("ppo", "ppo-sample") and arg:
+        return ppo_policy(arg, sample=kind == "ppo-sample")
+    raise ValueError(f"policy {spec!r}; allowed: random, heuristic, wander, champion:PATH, ppo:PATH, ppo-sample:PATH")
 
 
 def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
@@ -199,7 +210,7 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="gathering-compare", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--policy", action="append", required=True,
-                        help="random | heuristic | wander | champion:PATH | ppo:PATH (repeat)")
+                        help="random | heuristic | wander | champion:PATH | ppo:PATH | ppo-sample:PATH (repeat)")
     parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3))
     parser.add_argument("--steps", type=int, default=10_000, help="max_cycles per episode")
     parser.add_argument("--robots", type=int, default=20)

@@ -17,7 +17,8 @@ SB3 calls timesteps); ``--max-minutes`` stops earlier on wall-clock. Writes into
 log, plus ``rollout/ft_mean`` and ``rollout/team_return_mean``), ``curve.csv`` (one row per
 finished training episode: env steps, minutes, ft, team return), ``curve.png`` (ft and team
 return vs environment steps) and ``evaluation.json`` (ft over ``--eval-episodes`` held-out
-seeds, 10 000 onwards, never used in training).
+seeds, 10 000 onwards, never used in training; with the policy's mean actions and with actions
+sampled as in training).
 """
 
 from __future__ import annotations
@@ -118,9 +119,13 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--reward-scope", choices=REWARD_SCOPES, default="team")
     p.add_argument("--morphology", type=Path, help="champion JSON whose morphology to use (default: Khepera III)")
     p.add_argument("--env-steps", type=int, default=500_000, help="training budget in environment steps")
+    p.add_argument("--timesteps", type=int, default=None,
+                   help="training budget in robot-steps (SB3 timesteps) instead of --env-steps")
     p.add_argument("--max-minutes", type=float, default=None, help="stop training after this many minutes")
     p.add_argument("--n-steps", type=int, default=256, help="PPO rollout length per sub-environment")
     p.add_argument("--gamma", type=float, default=0.99)
+    p.add_argument("--ent-coef", type=float, default=0.01,
+                   help="entropy bonus (default 0.01; with 0 training collapsed, see docs/rl/README.md)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--eval-episodes", type=int, default=5)
     p.add_argument("--out", type=Path, default=Path("runs/ppo"))
@@ -145,12 +150,13 @@ def main(argv: list[str] | None = None) -> None:
 
     # 3. PPO with one shared policy; logs to stdout and CSV.
     model = PPO("MlpPolicy", venv, n_steps=args.n_steps, batch_size=min(2048, args.n_steps * venv.num_envs),
-                n_epochs=4, learning_rate=3e-4, gamma=args.gamma, gae_lambda=0.95, ent_coef=0.01,
+                n_epochs=4, learning_rate=3e-4, gamma=args.gamma, gae_lambda=0.95, ent_coef=args.ent_coef,
                 seed=args.seed, verbose=1, device="cpu")
     model.set_logger(configure(str(args.out), ["stdout", "csv"]))
     log = EpisodeLog(args.out / "curve.csv", args.robots, args.max_minutes)
     start = time.perf_counter()
-    model.learn(total_timesteps=args.env_steps * args.robots, callback=log, progress_bar=False)
+    budget = args.timesteps if args.timesteps is not None else args.env_steps * args.robots
+    model.learn(total_timesteps=budget, callback=log, progress_bar=False)
     minutes = (time.perf_counter() - start) / 60
     log.save()
     env_steps = model.num_timesteps // args.robots
@@ -164,15 +170,18 @@ def main(argv: list[str] | None = None) -> None:
     # 4. Evaluation on held-out seeds, through the same code path as gathering-compare.
     eval_steps = args.eval_steps or args.steps
     seeds = list(range(EVAL_SEED, EVAL_SEED + args.eval_episodes))
-    row = compare([ppo_policy(str(model_path))],
-                  {"environment": args.environment, "max_cycles": eval_steps, "num_robots": args.robots}, seeds)[0]
+    row, sampled = compare([ppo_policy(str(model_path)), ppo_policy(str(model_path), sample=True)],
+                           {"environment": args.environment, "max_cycles": eval_steps, "num_robots": args.robots},
+                           seeds)
     report = {"environment": args.environment, "reward": args.reward, "attach_reward": args.attach_reward,
               "reward_scope": args.reward_scope, "worlds": args.worlds, "train_steps": args.steps,
               "env_steps": env_steps, "robot_steps": model.num_timesteps, "train_minutes": round(minutes, 2),
-              "eval_steps": eval_steps, "eval_seeds": seeds, **row}
+              "eval_steps": eval_steps, "eval_seeds": seeds, **row,
+              "sampled": {"ft_mean": sampled["ft_mean"], "ft_std": sampled["ft_std"]}}
     (args.out / "evaluation.json").write_text(json.dumps(report, indent=1))
     print(f"trained {env_steps} env steps ({model.num_timesteps} robot-steps) in {minutes:.1f} min; "
-          f"ft over {len(seeds)} held-out episodes of {eval_steps} steps: {row['ft_mean']:.2f} +- {row['ft_std']:.2f}")
+          f"ft over {len(seeds)} held-out episodes of {eval_steps} steps: {row['ft_mean']:.2f} +- {row['ft_std']:.2f} "
+          f"(mean actions), {sampled['ft_mean']:.2f} +- {sampled['ft_std']:.2f} (sampled actions)")
     print(f"wrote {model_path}, {args.out / 'curve.png'}, {args.out / 'evaluation.json'}")
 
 

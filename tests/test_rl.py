@@ -168,3 +168,23 @@ def test_compare_wander_runs(tmp_path, capsys):
                          "--robots", "10", "--episodes", "2", "--seed", "9", "--out", str(tmp_path)]) == 0
     rows = {r.split(",")[0]: r.split(",") for r in (tmp_path / "compare.csv").read_text().splitlines()[1:]}
     assert set(rows) == {"wander", "random"} and rows["wander"][1] == "6"
+
+
+def test_ppo_sample_policy_is_seeded_and_differs_from_the_mean(tmp_path):
+    from evolution.compare import compare, make_policy
+
+    env = parallel_env(environment=1, num_robots=3, max_cycles=20)
+    env.reset(seed=0)
+    vec = ss.concat_vec_envs_v1(ss.pettingzoo_env_to_vec_env_v1(env), 1, num_cpus=0, base_class="stable_baselines3")
+    sb3.PPO("MlpPolicy", vec, n_steps=16, batch_size=48, device="cpu").save(tmp_path / "tiny.zip")
+    sample, mean = make_policy(f"ppo-sample:{tmp_path / 'tiny.zip'}"), make_policy(f"ppo:{tmp_path / 'tiny.zip'}")
+    assert sample.name == "ppo-sample:tiny" and mean.name == "ppo:tiny"
+    obs = np.full((3, 6), 0.5, np.float32)
+    sample.reset(7)
+    first = sample.act(obs)
+    sample.reset(7)
+    np.testing.assert_array_equal(sample.act(obs), first)               # seeded by the episode seed
+    assert not np.array_equal(first, mean.act(obs))
+    np.testing.assert_array_equal(mean.act(obs), mean.act(obs))         # the mean is deterministic
+    rows = compare([sample, sample], {"environment": 1, "max_cycles": 30, "num_robots": 3}, [1, 2])
+    assert rows[0]["ft_mean"] == rows[1]["ft_mean"]
