@@ -120,14 +120,16 @@ class WorldConfig:
     reward: str = "task"
     """'task': 100 * (change in gathered value) / total value per step (sums to eq. 1's
     value part). 'shaped': the task reward plus potential-based shaping Phi(s') - Phi(s)
-    and ``attach_reward`` per attachment; see ``gathering_env.rewards`` and docs/rl/."""
+    (blocks' distance to the zone, ``attach_reward`` per attached robot); see
+    ``gathering_env.rewards`` and docs/rl/."""
     attach_reward: float = 1.0
-    """Bonus per robot that attaches to a block (reward='shaped' only), in the units of the
-    task reward (gathering everything is worth 100)."""
+    """reward='shaped' only: each robot attached to a block adds this to the potential, so a
+    robot earns it when it attaches and gives it back when released (its block gathered);
+    in the units of the task reward (gathering everything is worth 100)."""
     reward_scope: str = "team"
-    """'team': every robot receives the team reward. 'local': a block's shaping term goes to
-    the robots attached to it (split equally), an attachment bonus to the attaching robot,
-    the rest equally to all robots, so the robots' rewards sum to the team reward."""
+    """'team': every robot receives the team reward. 'local': a block's distance term goes to
+    the robots attached to it (split equally), a robot's attachment term to that robot, the
+    rest equally to all robots, so the robots' rewards sum to the team reward."""
 
     # --- implementation ----------------------------------------------------------------
     kernel: str = "compiled"

@@ -10,17 +10,19 @@ depends on these options.
 * ``reward="shaped"``: the task reward plus ``F = Phi(s') - Phi(s)`` with the potential
 
       Phi(s) = -100 * sum_b value_b * d_b(s) / (total value * arena diagonal)
+               + attach_reward * (number of robots attached to a block)
 
   where ``d_b`` is the distance from block b's centre to the part of the zone its centre
-  must reach for the (unrotated) block to lie wholly inside (0 for a gathered block), so
-  ``Phi`` lies in [-100, 0]; plus ``attach_reward`` for every robot that attaches to a block.
-  With discount 1 the shaped return of an episode is the task return plus
-  ``Phi(end) - Phi(start)`` (plus the attachment bonuses), so the shaping leaves the optimal
+  must reach for the (unrotated) block to lie wholly inside (0 for a gathered block), so the
+  distance part lies in [-100, 0]. A robot thus earns ``attach_reward`` when it attaches and
+  gives it back when it is released (its block gathered): the bonus cannot be farmed by
+  gathering, pushing out and re-attaching. With discount 1 the shaped return of an episode
+  is the task return plus ``Phi(end) - Phi(start)``, so the shaping leaves the optimal
   policies unchanged (Ng, Harada & Russell 1999).
-* ``reward_scope="team"``: every robot receives the team reward. ``"local"``: the shaping
+* ``reward_scope="team"``: every robot receives the team reward. ``"local"``: the distance
   term of a block goes to the robots attached to it at the start of the step (split
-  equally; to everyone equally if none), an attachment bonus to the robot that attached, and
-  the task reward equally to all N robots, so the robots' rewards sum to the team reward.
+  equally; to everyone equally if none), a robot's attachment term to that robot, and the
+  task reward equally to all N robots, so the robots' rewards sum to the team reward.
 """
 
 from __future__ import annotations
@@ -55,9 +57,10 @@ def block_potentials(config: WorldConfig, block_pos: np.ndarray, block_half: np.
 
 
 def potential(config: WorldConfig, block_pos: np.ndarray, block_half: np.ndarray,
-              block_value: np.ndarray) -> np.ndarray:
-    """Phi of each world: (..., B, 2) block centres -> (...)."""
-    return block_potentials(config, block_pos, block_half, block_value).sum(axis=-1)
+              block_value: np.ndarray, robot_attached: np.ndarray) -> np.ndarray:
+    """Phi of each world: (..., B, 2) block centres and (..., N) attachments -> (...)."""
+    return (block_potentials(config, block_pos, block_half, block_value).sum(axis=-1)
+            + config.attach_reward * (np.asarray(robot_attached) >= 0).sum(axis=-1))
 
 
 class RewardShaper:
@@ -95,9 +98,8 @@ class RewardShaper:
         robot = np.repeat(team[:, None] / n, n, axis=1) if self.local else None
         if self.shaped:
             change = block_potentials(self.config, block_pos, self.block_half, self.block_value) - self._phi
-            attached = np.asarray(robot_attached)
-            new = (before < 0) & (attached >= 0)
-            team += change.sum(axis=1) + self.config.attach_reward * new.sum(axis=1)
+            holds = (np.asarray(robot_attached) >= 0).astype(np.float64) - (before >= 0)
+            team += change.sum(axis=1) + self.config.attach_reward * holds.sum(axis=1)
             if self.local:
                 blocks = change.shape[1]
                 holding = before >= 0
@@ -106,7 +108,7 @@ class RewardShaper:
                 share = np.where(counts > 0, change / np.maximum(counts, 1), 0.0)
                 robot += np.where(holding, np.take_along_axis(share, np.where(holding, before, 0), axis=1), 0.0)
                 robot += (change * (counts == 0)).sum(axis=1)[:, None] / n
-                robot += self.config.attach_reward * new
+                robot += self.config.attach_reward * holds
         if robot is None:
             robot = np.repeat(team[:, None], n, axis=1)
         return team, robot

@@ -17,14 +17,17 @@ KERNELS = ("compiled", "numpy")
 
 
 def hand_potential(cfg: WorldConfig, world) -> float:
-    """Phi by the docs' formula, block by block: -100 * sum v * d / (total value * diagonal)."""
+    """Phi by the docs' formula, block by block and robot by robot:
+    -100 * sum v * d / (total value * diagonal) + attach_reward * (robots attached)."""
     x0, y0, x1, y1 = cfg.zone_rect
     total = 0.0
     for (x, y), half, value in zip(world.block_pos.tolist(), world.block_half.tolist(), world.block_value.tolist()):
         dx = max(x0 + half - x, 0.0, x - (x1 - half))
         dy = max(y0 + half - y, 0.0, y - (y1 - half))
         total += value * math.sqrt(dx * dx + dy * dy)
-    return -100.0 * total / (cfg.total_value * math.hypot(cfg.arena_width, cfg.arena_height))
+    attached = sum(1 for block in world.robot_attached.tolist() if block >= 0)
+    return -100.0 * total / (cfg.total_value * math.hypot(cfg.arena_width, cfg.arena_height)) \
+        + cfg.attach_reward * attached
 
 
 def mixed_actions(policy: WanderTeam, obs: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -38,27 +41,27 @@ def mixed_actions(policy: WanderTeam, obs: np.ndarray, rng: np.random.Generator)
 @pytest.mark.parametrize("kernel", KERNELS)
 @pytest.mark.parametrize("attach_reward", [0.0, 2.5])
 def test_shaped_return_is_task_return_plus_potential_difference(kernel, attach_reward):
-    """With gamma = 1: sum of shaped rewards = task return + Phi(end) - Phi(start) (+ bonuses)."""
+    """With gamma = 1: sum of shaped rewards = task return + Phi(end) - Phi(start)."""
     cfg = WorldConfig.from_kwargs(environment=1, num_robots=12, max_cycles=400, kernel=kernel,
                                   reward="shaped", attach_reward=attach_reward)
-    moved = attachments_seen = 0
-    for seed in range(3):
+    moved = attachments_seen = released = 0
+    for seed in (0, 14):            # seed 14: a robot carries a block into the zone and is released
         sim = GatheringSimulation(cfg)
         obs = sim.reset(seed=seed)
         rng, policy = np.random.default_rng(seed), WanderTeam(seed=seed)
         phi_start, value_start = hand_potential(cfg, sim.world), sim.gathered_value
-        shaped, attachments = 0.0, 0
+        shaped = 0.0
         while not sim.done:
             before = sim.world.robot_attached.copy()
             obs, reward, _, _ = sim.step(mixed_actions(policy, obs, rng))
             shaped += reward
-            attachments += int(((before < 0) & (sim.world.robot_attached >= 0)).sum())
+            attachments_seen += int(((before < 0) & (sim.world.robot_attached >= 0)).sum())
+            released += int(((before >= 0) & (sim.world.robot_attached < 0)).sum())
         task_return = 100.0 * (sim.gathered_value - value_start) / cfg.total_value
         phi_end = hand_potential(cfg, sim.world)
-        assert shaped == pytest.approx(task_return + phi_end - phi_start + attach_reward * attachments, abs=1e-9)
+        assert shaped == pytest.approx(task_return + phi_end - phi_start, abs=1e-9)
         moved += abs(phi_end - phi_start) > 1e-3
-        attachments_seen += attachments
-    assert moved and attachments_seen        # the episodes did move blocks and attach robots
+    assert moved and attachments_seen and released   # the episodes moved blocks, attached and released robots
 
 
 def local_reference(cfg: WorldConfig, task: float, phi_before: np.ndarray, phi_after: np.ndarray,
@@ -73,7 +76,9 @@ def local_reference(cfg: WorldConfig, task: float, phi_before: np.ndarray, phi_a
             rewards[i] += change / len(holders or range(n))
     for i in range(n):
         if cfg.reward == "shaped" and attached_before[i] < 0 <= attached_after[i]:
-            rewards[i] += cfg.attach_reward
+            rewards[i] += cfg.attach_reward       # attached: earns the bonus
+        if cfg.reward == "shaped" and attached_after[i] < 0 <= attached_before[i]:
+            rewards[i] -= cfg.attach_reward       # released: gives it back
     return np.array(rewards)
 
 
@@ -133,15 +138,15 @@ def test_hand_scene_two_robots_push_a_medium_block(kernel):
     sim.step(np.zeros((3, 2)))
     assert world.robot_attached.tolist() == [0, 0, -1]
     first = sim.robot_reward
-    change = hand_potential(cfg, world) - phi0
+    change = hand_potential(cfg, world) - phi0 - 2 * 0.5      # the block's distance term
     np.testing.assert_allclose(first, [0.5 + change / 3, 0.5 + change / 3, change / 3], atol=1e-12)
     for _ in range(20):                                # attached robots drive the block to the zone
         phi = hand_potential(cfg, world)
         sim.step(np.zeros((3, 2)))
         change = hand_potential(cfg, world) - phi
         np.testing.assert_allclose(sim.robot_reward, [change / 2, change / 2, 0.0], atol=1e-12)
-    assert hand_potential(cfg, world) > phi0 + 1e-3    # the block came nearer the zone
-    # Phi's scale: value 2 at distance d from the zone, total value 2, 40 x 40 arena
+    assert hand_potential(cfg, world) > phi0 + 1.0 + 1e-3    # the block came nearer the zone
+    # Phi's scale: value 2 at distance d from the zone, total value 2, 40 x 40 arena, nobody attached
     assert phi0 == pytest.approx(-100 * 2 * (20.0 - (8.0 - half)) / (2 * math.hypot(40, 40)))
 
 
