@@ -11,7 +11,8 @@ the quick evolution run (``CHAMPION/champion.json``, ``stats.csv``), runs
   champion, the PPO runs of that environment);
 * ``curves-env<E>.png``: ft of the training episodes vs environment steps of every PPO run,
   with the evolution run's budget and best training ft marked;
-* ``budgets.md``: training budget of each trained policy in environment steps and minutes.
+* ``budgets.md``: training budget of each trained policy in environment steps and minutes;
+* ``rows.json``: every policy's row, computed once (rerun after more runs finish).
 """
 
 from __future__ import annotations
@@ -83,14 +84,18 @@ def main() -> None:
     parser.add_argument("--champion", type=Path, default=Path("out/quick"))
     parser.add_argument("--out", type=Path, default=Path("docs/rl"))
     parser.add_argument("--steps", type=int, nargs="+", default=[2000, 10_000])
+    parser.add_argument("--only-baselines", action="store_true", help="fill the cache with the baselines' rows")
     args = parser.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    cache_path = args.out / "rows.json"
+    cache = json.loads(cache_path.read_text()) if cache_path.exists() else {}
     evolution = evolution_budget(args.champion)
     budgets = ["| policy | trained in | env steps | robot-steps | minutes (this machine) |", "|---|---|---|---|---|",
                f"| champion:{args.champion.name} (HyperNEAT-M, {evolution['generations']} generations) | env "
                f"{evolution['environment']}, {evolution['max_cycles']}-step trials | {evolution['env_steps']:,} | "
                f"{evolution['env_steps'] * 20:,} | {evolution['minutes']:.1f} |"]
     for environment in (1, 2):
-        runs = ppo_runs(args.runs, environment)
+        runs = [] if args.only_baselines else ppo_runs(args.runs, environment)
         for run in runs:
             report = json.loads((run / "evaluation.json").read_text())
             budgets.append(f"| ppo:{run.name} | env {environment}, {report['train_steps']}-step episodes | "
@@ -99,8 +104,14 @@ def main() -> None:
         specs = ["random", "heuristic", "wander", f"champion:{args.champion / 'champion.json'}"]
         specs += [f"{kind}:{run / 'model.zip'}" for run in runs for kind in ("ppo", "ppo-sample")]
         for steps in args.steps:
-            policies = [make_policy(s) for s in specs]
-            rows = compare(policies, {"environment": environment, "max_cycles": steps, "num_robots": 20}, SEEDS)
+            rows = []
+            for spec in specs:
+                key = f"{spec}|env{environment}|{steps}"
+                if key not in cache:    # a policy's row is computed once; delete rows.json to redo
+                    config = {"environment": environment, "max_cycles": steps, "num_robots": 20}
+                    cache[key] = compare([make_policy(spec)], config, SEEDS)[0]
+                    cache_path.write_text(json.dumps(cache, indent=1))
+                rows.append(cache[key])
             title = (f"environment {environment}, 20 robots, {steps} steps, 5 held-out episodes "
                      f"(seeds {SEEDS[0]}..{SEEDS[-1]})")
             md, csv_path, png = write_outputs(rows, args.out / "tmp", title)
