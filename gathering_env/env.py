@@ -25,9 +25,9 @@ Three world options (``gathering_env.rewards``; docs/rl/README.md); ``ft`` never
 
 | option | values | meaning |
 |---|---|---|
-| ``reward`` | ``"task"`` (default), ``"shaped"`` | task: the team reward ``100 * (change in gathered value) / total value``, so an episode's rewards sum to the value part of ``ft`` (paper eq. 1; the time bonus is reported in ``infos``, not rewarded). shaped: plus ``Phi(s') - Phi(s)``, ``Phi = -100 * sum_b value_b * distance_b(zone) / (total value * arena diagonal)``, plus ``attach_reward`` per attachment. With discount 1 the shaped return is the task return + ``Phi(end) - Phi(start)`` (+ attachment bonuses): potential-based shaping keeps the optimal policies (Ng, Harada & Russell 1999). |
-| ``attach_reward`` | float >= 0, default 1.0 | bonus for each robot that attaches to a block (shaped only) |
-| ``reward_scope`` | ``"team"`` (default), ``"local"`` | team: every robot receives the team reward. local: a block's shaping term is split among the robots attached to it, an attachment bonus goes to the attaching robot, the rest equally to all robots; the robots' rewards sum to the team reward. |
+| ``reward`` | ``"task"`` (default), ``"shaped"`` | task: the team reward ``100 * (change in gathered value) / total value``, so an episode's rewards sum to the value part of ``ft`` (paper eq. 1; the time bonus is reported in ``infos``, not rewarded). shaped: plus ``Phi(s') - Phi(s)``, ``Phi = -100 * sum_b value_b * distance_b(zone) / (total value * arena diagonal) + attach_reward * (robots attached)``. With discount 1 the shaped return is the task return + ``Phi(end) - Phi(start)``: potential-based shaping keeps the optimal policies (Ng, Harada & Russell 1999). |
+| ``attach_reward`` | float >= 0, default 1.0 | shaped only: a robot earns it when it attaches to a block and gives it back when released (its block gathered) |
+| ``reward_scope`` | ``"team"`` (default), ``"local"`` | team: every robot receives the team reward. local: a block's distance term is split among the robots attached to it, a robot's attachment term goes to that robot, the rest equally to all robots; the robots' rewards sum to the team reward. |
 
 ## Episode end
 *Terminated* when every block lies wholly inside the zone; *truncated* after
