@@ -210,3 +210,10 @@ def test_bad_reward_options_are_value_errors(option, value, message):
         parallel_env(**{option: value})
     with pytest.raises(ValueError, match=message):
         VectorSimulation(2, **{option: value})
+
+
+def test_pettingzoo_api_test_with_local_shaped_rewards():
+    from pettingzoo.test import parallel_api_test
+
+    parallel_api_test(parallel_env(environment=1, num_robots=4, max_cycles=60, reward="shaped",
+                                   reward_scope="local"), num_cycles=80)
