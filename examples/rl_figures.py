@@ -12,6 +12,7 @@ the quick evolution run (``CHAMPION/champion.json``, ``stats.csv``), runs
 * ``curves-env<E>.png``: ft of the training episodes vs environment steps of every PPO run,
   with the evolution run's budget and best training ft marked;
 * ``budgets.md``: training budget of each trained policy in environment steps and minutes;
+* ``summary.md``: ft of every policy in every setting in one table;
 * ``rows.json``: every policy's row, computed once (rerun after more runs finish).
 """
 
@@ -59,7 +60,7 @@ def plot_curves(runs: list[Path], evolution: dict, path: Path, environment: int)
     if evolution and evolution["environment"] == environment:
         ax.axvline(evolution["env_steps"], color="grey", ls="--", lw=1)
         ax.plot([evolution["env_steps"]], [evolution["best_ft"]], "k*", markersize=10,
-                label=f"quick evolution: best training ft at {evolution['env_steps']:,} env steps")
+                label=f"quick evolution: best training ft ({evolution['max_cycles']}-step trials) at {evolution['env_steps']:,} env steps")
     ax.set_xlabel("environment steps (one step of one 20-robot world)")
     ax.set_ylabel("ft of training episodes (2 000 steps)")
     ax.set_title(f"PPO learning curves, environment {environment}", fontsize=9)
@@ -76,6 +77,21 @@ def evolution_budget(run: Path) -> dict:
     return {"env_steps": sum(int(r["steps"]) for r in rows), "minutes": sum(float(r["seconds"]) for r in rows) / 60,
             "best_ft": max(float(r["task_best"]) for r in rows), "generations": len(rows),
             "environment": env.get("environment", 1), "max_cycles": env.get("max_cycles")}
+
+
+def write_summary(cache: dict, path: Path, steps_list: list[int]) -> None:
+    """One row per policy, one column per (environment, episode length): ft mean ± std."""
+    columns = [(e, n) for e in (1, 2) for n in steps_list]
+    names: dict[str, dict] = {}
+    for key, row in cache.items():
+        spec, env, steps = key.split("|")
+        names.setdefault(row["policy"], {})[(int(env[3:]), int(steps))] = row
+    header = "| policy | " + " | ".join(f"env {e}, {n:,} steps" for e, n in columns) + " |"
+    lines = [header, "|---" * (len(columns) + 1) + "|"]
+    for name, cells in names.items():
+        lines.append(f"| {name} | " + " | ".join(
+            f"{cells[c]['ft_mean']:.1f} ± {cells[c]['ft_std']:.1f}" if c in cells else "—" for c in columns) + " |")
+    path.write_text("ft (mean ± std over the 5 held-out episodes, seeds 10 000..10 004)\n\n" + "\n".join(lines) + "\n")
 
 
 def main() -> None:
@@ -119,6 +135,7 @@ def main() -> None:
                 src.replace(args.out / f"compare-env{environment}-{steps}.{suffix}")
             print((args.out / f"compare-env{environment}-{steps}.md").read_text())
     (args.out / "tmp").rmdir()
+    write_summary(cache, args.out / "summary.md", args.steps)
     (args.out / "budgets.md").write_text("\n".join(budgets) + "\n")
     print("\n".join(budgets))
 
