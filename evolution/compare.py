@@ -1,6 +1,6 @@
 """Compare team policies on the same seeds: random, a fixed search pattern, evolved champions, PPO.
 
-``gathering-compare --policy random --policy heuristic --policy champion:run/champion.json
+``gathering-compare --policy random --policy heuristic --policy wander --policy champion:run/champion.json
 --policy ppo:ppo/model.zip --environment 2 --episodes 5 --out compare/`` runs every policy on
 the same environment and episode seeds and writes ``compare.md`` / ``compare.csv`` (mean +- std
 ft, blocks gathered by type, time to finish) and ``compare.png`` (a bar plot).
@@ -11,9 +11,15 @@ Policies (each carries the morphology it was made for):
 * ``heuristic``: the pickup heuristic with a fixed search pattern on Khepera III readings:
   drive forward on a slight curve, turn on the spot while the front ultrasonic or either
   infrared sensor reports an obstacle close ahead.
+* ``wander``: the speed benchmark's explorer (``gathering_env.policies.WanderTeam``): forward
+  at 0.8 of top speed with a drift redrawn every 50 steps, spin on the spot when the front
+  ultrasonic has read an obstacle very close for 20 steps (Khepera III morphology).
 * ``champion:PATH``: an evolved team from a champion JSON (its own morphology).
 * ``ppo:PATH``: a Stable-Baselines3 PPO model (``examples/rl_ppo.py``) with the morphology
-  saved next to it (``PATH`` with suffix ``.morphology.json``), Khepera III if absent.
+  saved next to it (``PATH`` with suffix ``.morphology.json``), Khepera III if absent; its
+  deterministic actions (the policy's mean).
+* ``ppo-sample:PATH``: the same model with actions sampled from its distribution, as in
+  training (torch's generator seeded by the episode seed).
 """
 
 from __future__ import annotations
@@ -28,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from gathering_env import Morphology, WorldConfig, parallel_env
+from gathering_env.policies import WanderTeam
 
 from .experiment import LIMITS
 from .guard import ArgumentParser, check_output_dir, command, int_arg
@@ -67,6 +74,12 @@ def heuristic_policy() -> Policy:
     return Policy("heuristic", Morphology.khepera_iii(), act)
 
 
+def wander_policy() -> Policy:
+    """The benchmark's explorer (``gathering_env.policies.WanderTeam``) on Khepera III."""
+    team = WanderTeam(Morphology.khepera_iii())
+    return Policy("wander", team.morphology, team.act, team.reset)
+
+
 def champion_policy(path: str) -> Policy:
     from .champion import load_champion
 
@@ -74,7 +87,9 @@ def champion_policy(path: str) -> Policy:
     return Policy(f"champion:{Path(path).parent.name or path}", champion.morphology, champion.controller.act)
 
 
-def ppo_policy(path: str) -> Policy:
+def ppo_policy(path: str, sample: bool = False) -> Policy:
+    """A saved SB3 model; deterministic actions (the policy's mean), or with ``sample`` actions
+    drawn from the policy's distribution (torch's generator seeded by the episode seed)."""
     try:
         from stable_baselines3 import PPO
     except ImportError:
@@ -102,12 +117,18 @@ def ppo_policy(path: str) -> Policy:
                          f"has {len(morphology)} sensors; save the morphology as {morph_path.name}")
 
     def act(obs):
-        action, _ = model.predict(obs.astype(np.float32), deterministic=True)
+        action, _ = model.predict(obs.astype(np.float32), deterministic=not sample)
         return np.asarray(action, dtype=np.float64).reshape(obs.shape[0], 2)
+
+    def reset(seed):
+        if sample:
+            import torch
+
+            torch.manual_seed(seed)
 
     # SB3 saves "model.zip" by default: name such a model after its run directory instead.
     label = model_path.parent.name if model_path.stem == "model" and model_path.parent.name else model_path.stem
-    return Policy(f"ppo:{label}", morphology, act)
+    return Policy(f"{'ppo-sample' if sample else 'ppo'}:{label}", morphology, act, reset)
 
 
 def make_policy(spec: str) -> Policy:
@@ -116,11 +137,14 @@ def make_policy(spec: str) -> Policy:
         return random_policy()
     if kind == "heuristic" and not arg:
         return heuristic_policy()
+    if kind == "wander" and not arg:
+        return wander_policy()
     if kind == "champion" and arg:
         return champion_policy(arg)
-    if kind == "ppo" and arg:
-        return ppo_policy(arg)
-    raise ValueError(f"--policy {spec}: unknown policy; allowed: random, heuristic, champion:PATH, ppo:PATH")
+    if kind in ("ppo", "ppo-sample") and arg:
+        return ppo_policy(arg, sample=kind == "ppo-sample")
+    raise ValueError(f"--policy {spec}: unknown policy; allowed: random, heuristic, wander, champion:PATH, "
+                     "ppo:PATH, ppo-sample:PATH")
 
 
 def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
@@ -206,7 +230,7 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser = ArgumentParser(prog="gathering-compare", description=__doc__,
                             formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--policy", action="append", required=True,
-                        help="random | heuristic | champion:PATH | ppo:PATH (repeat)")
+                        help="random | heuristic | wander | champion:PATH | ppo:PATH | ppo-sample:PATH (repeat)")
     parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3))
     parser.add_argument("--steps", type=int_arg(1, 10**9), default=10_000, help="max_cycles per episode")
     parser.add_argument("--robots", type=int_arg(1, 1000), default=20)

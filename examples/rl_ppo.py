@@ -1,53 +1,140 @@
-"""Shared-parameter PPO for the whole team (Stable-Baselines3 + SuperSuit), on a fixed morphology.
+"""Shared-parameter PPO for the whole team (Stable-Baselines3) on the many-worlds vector env.
 
-Every robot is one "environment" of a vectorised env (SuperSuit's PettingZoo-to-vec-env
-wrappers, the route PettingZoo's documentation shows), so one PPO policy is trained on all
-robots' experience at once and drives every robot at test time.
+Every robot of every world is one sub-environment of ``gathering_env.sb3.GatheringVecEnv``,
+so one PPO policy is trained on all robots' experience at once and drives every robot at
+test time. The reward is shaped by default (``--reward shaped``: potential-based shaping
+towards the zone plus a bonus per attachment; see docs/rl/README.md); ``--reward task`` is
+the task's own sparse reward.
 
-    pip install -e ".[rl]"          # supersuit, stable-baselines3, torch==2.13.0 (the CPU build here)
-    python examples/rl_ppo.py --environment 1 --timesteps 200000 --out runs/ppo-env1
+    pip install -e ".[rl]"          # stable-baselines3, torch==2.13.0 (the CPU build here)
+    python examples/rl_ppo.py --environment 1 --env-steps 500000 --out runs/ppo-env1
+    python examples/rl_ppo.py --reward-scope local --max-minutes 10 ...
     python examples/rl_ppo.py --morphology runs/quick/champion.json ...   # an evolved champion's sensors
 
-Writes ``model.zip`` (the policy), ``model.morphology.json`` (the sensors it was trained with),
-``progress.csv`` (SB3's training log; TensorBoard too if ``tensorboard`` is installed) and
-``evaluation.json`` (ft over ``--eval-episodes`` fresh seeds). Timesteps count robot-steps:
-``--timesteps 200000`` with 20 robots is 10 000 environment steps.
+Budgets count environment steps (one step of one world of N robots = N robot-steps, what
+SB3 calls timesteps); ``--max-minutes`` stops earlier on wall-clock. Writes into ``--out``:
+``model.zip`` (the policy), ``model.morphology.json`` (its sensors), ``progress.csv`` (SB3's
+log, plus ``rollout/ft_mean`` and ``rollout/team_return_mean``), ``curve.csv`` (one row per
+finished training episode: env steps, minutes, ft, team return), ``curve.png`` (ft and team
+return vs environment steps) and ``evaluation.json`` (ft over ``--eval-episodes`` held-out
+seeds, 10 000 onwards, never used in training; with the policy's mean actions and with actions
+sampled as in training).
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib.util
+import csv
 import json
+import os
 import time
 from pathlib import Path
 
-import supersuit as ss
-from stable_baselines3 import PPO
-from stable_baselines3.common.logger import configure
-from stable_baselines3.common.utils import set_random_seed
-from stable_baselines3.common.vec_env import VecMonitor
+os.environ.setdefault("OMP_NUM_THREADS", "1")   # two processes on 2 cores otherwise thrash
 
-from evolution.compare import compare, ppo_policy
-from gathering_env import Morphology, parallel_env
+import numpy as np  # noqa: E402
+import torch  # noqa: E402
+from stable_baselines3 import PPO  # noqa: E402
+from stable_baselines3.common.callbacks import BaseCallback  # noqa: E402
+from stable_baselines3.common.logger import configure  # noqa: E402
+from stable_baselines3.common.vec_env import VecMonitor  # noqa: E402
+
+from evolution.compare import compare, ppo_policy  # noqa: E402
+from gathering_env import Morphology  # noqa: E402
+from gathering_env.config import REWARD_SCOPES, REWARDS, WorldConfig  # noqa: E402
+from gathering_env.sb3 import GatheringVecEnv  # noqa: E402
+
+EVAL_SEED = 10_000
+"""First held-out evaluation seed (training episode seeds come from the --seed generator)."""
 
 
-def parse_args() -> argparse.Namespace:
+class EpisodeLog(BaseCallback):
+    """Records ft and the team's (shaped) return of every finished training episode."""
+
+    def __init__(self, path: Path, num_robots: int, max_minutes: float | None) -> None:
+        super().__init__()
+        self.path, self.num_robots, self.max_minutes = path, num_robots, max_minutes
+        self.rows: list[dict] = []
+        self.start = time.perf_counter()
+
+    def _on_step(self) -> bool:
+        minutes = (time.perf_counter() - self.start) / 60
+        for k, info in enumerate(self.locals["infos"]):
+            if k % self.num_robots == 0 and "task_performance" in info:   # one row per world
+                self.rows.append({"env_steps": self.num_timesteps // self.num_robots, "minutes": round(minutes, 3),
+                                  "ft": info["task_performance"], "team_return": info["team_return"]})
+        return self.max_minutes is None or minutes < self.max_minutes
+
+    def _on_rollout_end(self) -> None:
+        recent = self.rows[-20:]
+        if recent:
+            self.logger.record("rollout/ft_mean", float(np.mean([r["ft"] for r in recent])))
+            self.logger.record("rollout/team_return_mean", float(np.mean([r["team_return"] for r in recent])))
+            self.save()
+
+    def save(self) -> None:
+        with open(self.path, "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=["env_steps", "minutes", "ft", "team_return"])
+            writer.writeheader()
+            writer.writerows(self.rows)
+
+
+def plot_curve(rows: list[dict], path: Path, title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 3.6), constrained_layout=True)
+    if rows:
+        steps = np.array([r["env_steps"] for r in rows])
+        ft = np.array([r["ft"] for r in rows])
+        ret = np.array([r["team_return"] for r in rows])
+        window = max(1, len(rows) // 20)
+        smooth = np.convolve(ft, np.ones(window) / window, mode="valid")
+        ax.plot(steps, ft, ".", color="tab:blue", alpha=0.3, markersize=3)
+        ax.plot(steps[window - 1:], smooth, color="tab:blue", label=f"ft (mean of {window} episodes)")
+        ax.plot(steps, ret, ".", color="tab:orange", alpha=0.3, markersize=3)
+        ax.plot(steps[window - 1:], np.convolve(ret, np.ones(window) / window, mode="valid"), color="tab:orange",
+                label="team return (training reward)")
+        ax.legend(fontsize=8)
+    ax.set_xlabel("environment steps (world steps; x robots = SB3 timesteps)")
+    ax.set_ylabel("per training episode")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--environment", type=int, default=1, choices=(1, 2, 3))
-    p.add_argument("--steps", type=int, default=1000, help="episode length (max_cycles) while training")
+    p.add_argument("--steps", type=int, default=2000, help="episode length (max_cycles) while training")
     p.add_argument("--eval-steps", type=int, default=None, help="episode length for the evaluation (default: --steps)")
     p.add_argument("--robots", type=int, default=20)
+    p.add_argument("--worlds", type=int, default=4, help="worlds stepped together (sub-environments = worlds x robots)")
+    p.add_argument("--reward", choices=REWARDS, default="shaped")
+    p.add_argument("--attach-reward", type=float, default=WorldConfig.attach_reward,
+                   help=f"bonus per attachment with --reward shaped (default {WorldConfig.attach_reward})")
+    p.add_argument("--reward-scope", choices=REWARD_SCOPES, default="team")
     p.add_argument("--morphology", type=Path, help="champion JSON whose morphology to use (default: Khepera III)")
-    p.add_argument("--timesteps", type=int, default=200_000, help="robot-steps of training")
+    p.add_argument("--env-steps", type=int, default=500_000, help="training budget in environment steps")
+    p.add_argument("--timesteps", type=int, default=None,
+                   help="training budget in robot-steps (SB3 timesteps) instead of --env-steps")
+    p.add_argument("--max-minutes", type=float, default=None, help="stop training after this many minutes")
+    p.add_argument("--n-steps", type=int, default=256, help="PPO rollout length per sub-environment")
+    p.add_argument("--gamma", type=float, default=0.99)
+    p.add_argument("--ent-coef", type=float, default=0.01,
+                   help="entropy bonus (default 0.01; with 0 training collapsed, see docs/rl/README.md)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--eval-episodes", type=int, default=5)
     p.add_argument("--out", type=Path, default=Path("runs/ppo"))
-    return p.parse_args()
+    return p.parse_args(argv)
 
 
-def main() -> None:
-    args = parse_args()
+def main(argv: list[str] | None = None) -> None:
+    args = parse_args(argv)
+    torch.set_num_threads(1)
     args.out.mkdir(parents=True, exist_ok=True)
 
     # 1. The morphology: Khepera III or an evolved champion's sensors.
@@ -56,41 +143,46 @@ def main() -> None:
     else:
         morphology = Morphology.khepera_iii()
 
-    # 2. The team env, unchanged, turned into a vector env with one entry per robot.
-    env = parallel_env(environment=args.environment, num_robots=args.robots, max_cycles=args.steps,
-                       morphology=morphology)
-    # SuperSuit 3.11's SB3 wrapper cannot forward seeds (its ConcatVecEnv has no seed()), so the
-    # episodes are seeded on the env itself: later resets continue its seeded random stream.
-    env.reset(seed=args.seed)
-    vec_env = ss.pettingzoo_env_to_vec_env_v1(env)
-    vec_env = ss.concat_vec_envs_v1(vec_env, 1, num_cpus=0, base_class="stable_baselines3")
-    vec_env = VecMonitor(vec_env)  # episode return/length in the logs (rollout/ep_rew_mean)
-    set_random_seed(args.seed)  # numpy, torch, python
+    # 2. W worlds x N robots as one SB3 vector env; every robot is a sub-environment.
+    world = {"environment": args.environment, "num_robots": args.robots, "max_cycles": args.steps,
+             "reward": args.reward, "attach_reward": args.attach_reward, "reward_scope": args.reward_scope}
+    venv = VecMonitor(GatheringVecEnv(args.worlds, seed=args.seed, morphology=morphology, **world))
 
-    # 3. PPO with one shared policy; logs to stdout, CSV (and TensorBoard when available).
-    formats = ["stdout", "csv"] + (["tensorboard"] if importlib.util.find_spec("tensorboard") else [])
-    model = PPO("MlpPolicy", vec_env, n_steps=256, batch_size=1024, learning_rate=3e-4, gamma=0.995,
-                ent_coef=0.01, verbose=1, device="cpu")
-    model.set_logger(configure(str(args.out), formats))
+    # 3. PPO with one shared policy; logs to stdout and CSV.
+    model = PPO("MlpPolicy", venv, n_steps=args.n_steps, batch_size=min(2048, args.n_steps * venv.num_envs),
+                n_epochs=4, learning_rate=3e-4, gamma=args.gamma, gae_lambda=0.95, ent_coef=args.ent_coef,
+                seed=args.seed, verbose=1, device="cpu")
+    model.set_logger(configure(str(args.out), ["stdout", "csv"]))
+    log = EpisodeLog(args.out / "curve.csv", args.robots, args.max_minutes)
     start = time.perf_counter()
-    model.learn(total_timesteps=args.timesteps, progress_bar=False)
+    budget = args.timesteps if args.timesteps is not None else args.env_steps * args.robots
+    model.learn(total_timesteps=budget, callback=log, progress_bar=False)
     minutes = (time.perf_counter() - start) / 60
+    log.save()
+    env_steps = model.num_timesteps // args.robots
     model_path = args.out / "model.zip"
     model.save(model_path)
     (args.out / "model.morphology.json").write_text(json.dumps(morphology.to_dict(), indent=1))
+    title = (f"PPO env {args.environment}, reward={args.reward} ({args.reward_scope}), {args.worlds} worlds x "
+             f"{args.robots} robots, {args.steps}-step episodes")
+    plot_curve(log.rows, args.out / "curve.png", title)
 
-    # 4. Evaluation on fresh seeds, through the same code path as gathering-compare.
+    # 4. Evaluation on held-out seeds, through the same code path as gathering-compare.
     eval_steps = args.eval_steps or args.steps
-    seeds = list(range(10_000, 10_000 + args.eval_episodes))
-    row = compare([ppo_policy(str(model_path))],
-                  {"environment": args.environment, "max_cycles": eval_steps, "num_robots": args.robots}, seeds)[0]
-    report = {"environment": args.environment, "timesteps": args.timesteps,
-              "env_steps": args.timesteps // args.robots, "train_minutes": round(minutes, 2),
-              "eval_steps": eval_steps, "eval_seeds": seeds, **row}
+    seeds = list(range(EVAL_SEED, EVAL_SEED + args.eval_episodes))
+    row, sampled = compare([ppo_policy(str(model_path)), ppo_policy(str(model_path), sample=True)],
+                           {"environment": args.environment, "max_cycles": eval_steps, "num_robots": args.robots},
+                           seeds)
+    report = {"environment": args.environment, "reward": args.reward, "attach_reward": args.attach_reward,
+              "reward_scope": args.reward_scope, "worlds": args.worlds, "train_steps": args.steps,
+              "env_steps": env_steps, "robot_steps": model.num_timesteps, "train_minutes": round(minutes, 2),
+              "eval_steps": eval_steps, "eval_seeds": seeds, **row,
+              "sampled": {"ft_mean": sampled["ft_mean"], "ft_std": sampled["ft_std"]}}
     (args.out / "evaluation.json").write_text(json.dumps(report, indent=1))
-    print(f"trained {args.timesteps} robot-steps ({args.timesteps // args.robots} env steps) in {minutes:.1f} min; "
-          f"ft over {len(seeds)} episodes of {eval_steps} steps: {row['ft_mean']:.2f} +- {row['ft_std']:.2f}")
-    print(f"wrote {model_path}, {args.out / 'progress.csv'}, {args.out / 'evaluation.json'}")
+    print(f"trained {env_steps} env steps ({model.num_timesteps} robot-steps) in {minutes:.1f} min; "
+          f"ft over {len(seeds)} held-out episodes of {eval_steps} steps: {row['ft_mean']:.2f} +- {row['ft_std']:.2f} "
+          f"(mean actions), {sampled['ft_mean']:.2f} +- {sampled['ft_std']:.2f} (sampled actions)")
+    print(f"wrote {model_path}, {args.out / 'curve.png'}, {args.out / 'evaluation.json'}")
 
 
 if __name__ == "__main__":

@@ -27,6 +27,12 @@ ENVIRONMENT_PRESETS: dict[int, tuple[int, int, int]] = {
 #: Implementations of the step (``WorldConfig.kernel``).
 KERNELS: tuple[str, str] = ("compiled", "numpy")
 
+#: Reward signals (``WorldConfig.reward``): the task's own, or the task's plus shaping.
+REWARDS: tuple[str, str] = ("task", "shaped")
+
+#: Who receives which reward (``WorldConfig.reward_scope``).
+REWARD_SCOPES: tuple[str, str] = ("team", "local")
+
 #: Names of the three block types, index = type id.
 BLOCK_TYPE_NAMES: tuple[str, str, str] = ("small", "medium", "large")
 
@@ -110,6 +116,21 @@ class WorldConfig:
     """Bonus for gathering every block, scaled by the unused fraction of steps (paper: 20,
     original code: 10)."""
 
+    # --- reward (for learners; ft of eq. 1 does not depend on it) ---------------------
+    reward: str = "task"
+    """'task': 100 * (change in gathered value) / total value per step (sums to eq. 1's
+    value part). 'shaped': the task reward plus potential-based shaping Phi(s') - Phi(s)
+    (blocks' distance to the zone, ``attach_reward`` per attached robot); see
+    ``gathering_env.rewards`` and docs/rl/."""
+    attach_reward: float = 1.0
+    """reward='shaped' only: each robot attached to a block adds this to the potential, so a
+    robot earns it when it attaches and gives it back when released (its block gathered);
+    in the units of the task reward (gathering everything is worth 100)."""
+    reward_scope: str = "team"
+    """'team': every robot receives the team reward. 'local': a block's distance term goes to
+    the robots attached to it (split equally), a robot's attachment term to that robot, the
+    rest equally to all robots, so the robots' rewards sum to the team reward."""
+
     # --- implementation ----------------------------------------------------------------
     kernel: str = "compiled"
     """Which implementation computes everything of a step but pymunk's physics: 'compiled'
@@ -157,7 +178,7 @@ class WorldConfig:
             "pickup_reach", "collision_avoidance_distance", "ir_gamma", "bottom_falloff",
         ):
             _check_float(name, getattr(self, name), 0.0, math.inf, low_open=True)
-        for name in ("robot_friction", "block_friction", "time_bonus"):
+        for name in ("robot_friction", "block_friction", "time_bonus", "attach_reward"):
             _check_float(name, getattr(self, name), 0.0, math.inf)
         _check_float("block_friction_margin", self.block_friction_margin, 0.0, 1.0,
                      low_open=True, high_open=True)
@@ -184,6 +205,10 @@ class WorldConfig:
                 raise ValueError(f"{name}={value!r} must be a bool (True or False)")
         if self.ir_response not in ("linear", "gamma"):
             raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma'")
+        if self.reward not in REWARDS:
+            raise ValueError(f"reward={self.reward!r}; allowed: {', '.join(map(repr, REWARDS))}")
+        if self.reward_scope not in REWARD_SCOPES:
+            raise ValueError(f"reward_scope={self.reward_scope!r}; allowed: {', '.join(map(repr, REWARD_SCOPES))}")
         if self.kernel not in KERNELS:
             raise ValueError(f"kernel={self.kernel!r}; allowed: {', '.join(map(repr, KERNELS))}")
         if sum(self.block_counts) == 0:

@@ -24,6 +24,7 @@ import numpy as np
 
 from . import kernels
 from .config import WorldConfig
+from .rewards import RewardShaper
 from .sensors import Morphology
 from .world import STATE_ARRAYS, GatheringWorld
 
@@ -34,7 +35,9 @@ class CompiledWorlds:
     Arrays (after ``reset``): ``robot_pos`` (W, N, 2), ``robot_angle`` (W, N), ``block_pos``
     (W, B, 2), ``block_angle`` (W, B), ``robot_attached`` (W, N), ``block_sticky_side``
     (W, B), ``anchor_owner`` (W, B, K), ``gathered`` (W, B) bool, ``gathered_value`` (W,),
-    ``obs`` (W, N, S) float32, ``steps`` (W,) int, ``reward`` (W,) of the last step,
+    ``obs`` (W, N, S) float32, ``steps`` (W,) int, ``reward`` (W,) team reward of the last step
+    (``WorldConfig.reward``), ``robot_reward`` (W, N) per-robot rewards of the last step (None
+    for the default task reward with team scope, where every robot gets ``reward``),
     ``terminated`` / ``truncated`` (W,) bool.
     """
 
@@ -99,6 +102,8 @@ class CompiledWorlds:
         self.block_need = first.block_need.astype(np.float64)
         self.block_value = first.block_value.astype(np.float64)
         # room for every robot attaching and every robot being released in one step
+        self.shaper = RewardShaper(cfg, self.block_half, self.block_value)
+        self.robot_reward = np.zeros((w, n)) if self.shaper.active else None
         self._events = np.zeros((2 * w * n, 5), dtype=np.int64)
         self._weld_points = np.zeros((2 * w * n, 2))
 
@@ -117,6 +122,8 @@ class CompiledWorlds:
         self.active[which] = True
         self.steps[which] = 0
         self.reward[which] = 0.0
+        if self.robot_reward is not None:
+            self.robot_reward[which] = 0.0
         self.terminated[which] = False
         self.truncated[which] = False
         self.sense(which)
@@ -137,6 +144,9 @@ class CompiledWorlds:
         t0 = clock()
         active = self.active
         stepped = active.copy()
+        shaper = self.shaper
+        if shaper.active:
+            shaper.before(self.block_pos, self.robot_attached)
         kernels.drive(wheels, self.robot_pos, self.robot_angle, self.robot_attached, self.control_rows,
                       self.raw, self.params, self.flags, active, self.vel)
         substeps = self.config.physics_substeps
@@ -160,6 +170,8 @@ class CompiledWorlds:
             self._events, self._weld_points)
         if count:
             self._apply_events(count)
+        if shaper.active:
+            self.reward[:], self.robot_reward[:] = shaper.after(self.reward, self.block_pos, self.robot_attached)
         t3 = clock()
         self.sense(stepped)
         if self.timings is not None:

@@ -21,9 +21,13 @@ default Khepera III morphology S = 6: bottom, IR +40 deg, IR -40 deg, ultrasonic
 ultrasonic +90 deg, ultrasonic -90 deg.
 
 ## Rewards
-Every robot receives the same team reward: ``100 * (change in gathered value) / total
-value``. An episode's rewards therefore sum to the value part of the task performance
-``ft`` (paper eq. 1); the time bonus is reported in ``infos`` at the end, not rewarded.
+Three world options (``gathering_env.rewards``; docs/rl/README.md); ``ft`` never depends on them:
+
+| option | values | meaning |
+|---|---|---|
+| ``reward`` | ``"task"`` (default), ``"shaped"`` | task: the team reward ``100 * (change in gathered value) / total value``, so an episode's rewards sum to the value part of ``ft`` (paper eq. 1; the time bonus is reported in ``infos``, not rewarded). shaped: plus ``Phi(s') - Phi(s)``, ``Phi = -100 * sum_b value_b * distance_b(zone) / (total value * arena diagonal) + attach_reward * (robots attached)``. With discount 1 the shaped return is the task return + ``Phi(end) - Phi(start)``: potential-based shaping keeps the optimal policies (Ng, Harada & Russell 1999). |
+| ``attach_reward`` | float >= 0, default 1.0 | shaped only: a robot earns it when it attaches to a block and gives it back when released (its block gathered) |
+| ``reward_scope`` | ``"team"`` (default), ``"local"`` | team: every robot receives the team reward. local: a block's distance term is split among the robots attached to it, a robot's attachment term goes to that robot, the rest equally to all robots; the robots' rewards sum to the team reward. |
 
 ## Episode end
 *Terminated* when every block lies wholly inside the zone; *truncated* after
@@ -189,7 +193,10 @@ class GatheringEnv(ParallelEnv):
         obs, reward, terminated, truncated = self.sim.step(wheels)
         agents = self.agents
         observations = dict(zip(agents, obs))
-        rewards = dict.fromkeys(agents, reward)
+        if self.config.reward_scope == "local":
+            rewards = dict(zip(agents, self.sim.robot_reward.tolist()))
+        else:
+            rewards = dict.fromkeys(agents, reward)
         terminations = dict.fromkeys(agents, terminated)
         truncations = dict.fromkeys(agents, truncated)
         info = self._team_info()
@@ -210,7 +217,8 @@ class GatheringEnv(ParallelEnv):
 
         Returns:
             (observations (num_robots, num_sensors) float32, team reward, terminated,
-            truncated). ``infos`` are available from ``team_info()``. Ends the episode
+            truncated). ``infos`` are available from ``team_info()``, per-robot rewards
+            (``reward_scope``) from ``sim.robot_reward``. Ends the episode
             (``agents == []``) on termination or truncation, like ``step``.
         """
         if not self.agents:

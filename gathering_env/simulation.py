@@ -28,6 +28,7 @@ import numpy as np
 from .config import WorldConfig
 from .engine import CompiledWorlds
 from .heuristics import attached_wheels, avoidance_turns, pickup_candidates
+from .rewards import RewardShaper
 from .scoring import gathered_mask, task_performance
 from .sensing import SensorBank
 from .sensors import Morphology
@@ -78,11 +79,20 @@ class GatheringSimulation:
                 env and ``check_wheels`` do it.)
 
         Returns:
-            (observation (N, S) float32, team reward, terminated, truncated). The reward is
-            ``100 * (change in gathered value) / total value``, so an episode's rewards sum
-            to the value part of eq. 1.
+            (observation (N, S) float32, team reward, terminated, truncated). With the
+            default ``reward="task"`` the reward is ``100 * (change in gathered value) /
+            total value``, so an episode's rewards sum to the value part of eq. 1; with
+            ``reward="shaped"`` it includes the shaping terms (``gathering_env.rewards``).
+            ``robot_reward`` holds the step's per-robot rewards (``reward_scope``).
         """
         raise NotImplementedError
+
+    @property
+    def robot_reward(self) -> np.ndarray:
+        """(N,) each robot's reward of the last step: the team reward for every robot with
+        ``reward_scope="team"``, the local rewards (summing to it) with ``"local"``."""
+        robot = self._robot_reward
+        return np.full(self.config.num_robots, self.reward) if robot is None else robot.copy()
 
     # ------------------------------------------------------------------ statistics
     def blocks_gathered_by_type(self) -> tuple[int, int, int]:
@@ -117,6 +127,8 @@ class NumpySimulation(GatheringSimulation):
         self.world.reset(self._generator(seed))
         w = self.world
         self.bank = SensorBank(self.morphology, self.config, w.block_half, w.block_need)
+        self.shaper = RewardShaper(self.config, w.block_half, w.block_value)
+        self.reward, self._robot_reward = 0.0, None
         self.steps = 0
         self.done = False
         self.gathered = gathered_mask(w.block_pos, w.block_angle, w.block_half, self.config.zone_rect)
@@ -131,6 +143,9 @@ class NumpySimulation(GatheringSimulation):
         if self.done:
             raise RuntimeError("step() called after the episode ended; call reset() first")
         cfg, w = self.config, self.world
+        shaper = self.shaper
+        if shaper.active:
+            shaper.before(w.block_pos[None], w.robot_attached[None])
         wheels = np.clip(wheels, -1.0, 1.0)
         if cfg.collision_avoidance:
             wheels = avoidance_turns(w, wheels)
@@ -153,6 +168,11 @@ class NumpySimulation(GatheringSimulation):
         value = float(w.block_value[gathered].sum())
         reward = 100.0 * (value - self.gathered_value) / self.total_value
         self.gathered_value = value
+        self._robot_reward = None
+        if shaper.active:
+            team, robot = shaper.after(np.array([reward]), w.block_pos[None], w.robot_attached[None])
+            reward, self._robot_reward = float(team[0]), robot[0]
+        self.reward = reward
 
         terminated = bool(gathered.all())
         truncated = (not terminated) and self.steps >= cfg.max_cycles
@@ -168,6 +188,7 @@ class CompiledSimulation(GatheringSimulation):
         self.engine = CompiledWorlds(config, 1)
         self.world = self.engine.worlds[0]
         self._started = False
+        self.reward, self._robot_reward = 0.0, None
 
     def reset(self, seed: int | np.random.Generator | None = None,
               morphology: Morphology | None = None) -> np.ndarray:
@@ -175,6 +196,7 @@ class CompiledSimulation(GatheringSimulation):
             self.morphology = morphology
         self.engine.reset([self._generator(seed)], self.morphology)
         self._started = True
+        self.reward, self._robot_reward = 0.0, None
         return self.engine.obs[0].copy()
 
     def observe(self) -> np.ndarray:
@@ -186,6 +208,8 @@ class CompiledSimulation(GatheringSimulation):
         if not engine.active[0]:
             raise RuntimeError("step() called after the episode ended; call reset() first")
         engine.step(np.asarray(wheels, dtype=np.float64).reshape(1, -1, 2))
+        self.reward = float(engine.reward[0])
+        self._robot_reward = None if engine.robot_reward is None else engine.robot_reward[0]
         return (engine.obs[0].copy(), float(engine.reward[0]), bool(engine.terminated[0]),
                 bool(engine.truncated[0]))
 

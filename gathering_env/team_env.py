@@ -12,7 +12,9 @@ single-agent libraries.
 Out-of-range values are clipped; NaN/inf raise ``ValueError``.
 
 ## Reward, episode end, info
-As the PettingZoo env: the team reward ``100 * (change in gathered value) / total value``;
+As the PettingZoo env: the team reward (``reward="task"``: ``100 * (change in gathered value) /
+total value``; ``reward="shaped"``: plus the shaping terms; ``reward_scope`` does not apply, the
+single agent receives the team reward);
 terminated when every block is gathered, truncated after ``max_cycles`` steps; ``info`` holds
 ``gathered_value``, ``total_value``, ``blocks_gathered``, ``blocks_gathered_by_type``, ``steps``
 and, at the end, ``task_performance``.

@@ -23,6 +23,7 @@ Shapes: W worlds, N robots, S sensors, B blocks.
   out: they are not stepped, get reward 0, keep their last observation and keep reporting
   terminated/truncated until ``reset_world``. ``active`` (W,) says which worlds still run.
 * ``reset_world(w, seed)`` -> obs ``(N, S)``: a new episode in one world (auto-reset).
+* ``robot_rewards()`` (W, N): each robot's reward of the last step (``reward_scope``).
 * ``task_performance()`` (W,), ``gathered_value`` (W,), ``steps`` (W,),
   ``blocks_gathered_by_type()`` (W, 3).
 
@@ -121,9 +122,11 @@ class VectorSimulation:
             engine.step(wheels)
             return engine.obs.copy(), engine.reward.copy(), engine.terminated.copy(), engine.truncated.copy()
         reward = np.zeros(self.num_worlds)
+        self._robot_reward[:] = 0.0
         for w, sim in enumerate(self._sims):
             if not sim.done:
                 self._obs[w], reward[w], self._terminated[w], self._truncated[w] = sim.step(wheels[w])
+                self._robot_reward[w] = sim.robot_reward
         return self._obs.copy(), reward, self._terminated.copy(), self._truncated.copy()
 
     def check_wheels(self, wheels: np.ndarray) -> np.ndarray:
@@ -147,6 +150,8 @@ class VectorSimulation:
         self._obs = np.stack([sim.observe() for sim in self._sims])
         self._terminated = np.array([sim.done and sim.gathered.all() for sim in self._sims])
         self._truncated = np.array([sim.done and not sim.gathered.all() for sim in self._sims])
+        if not hasattr(self, "_robot_reward"):
+            self._robot_reward = np.zeros((self.num_worlds, self.config.num_robots))
 
     # ------------------------------------------------------------------ status
     @property
@@ -181,6 +186,16 @@ class VectorSimulation:
         gathered = self.gathered()
         types = self.worlds[0].block_type
         return np.stack([(gathered & (types == t)).sum(axis=1) for t in range(3)], axis=1)
+
+    def robot_rewards(self) -> np.ndarray:
+        """(W, N) each robot's reward of the last step (``WorldConfig.reward_scope``): the
+        world's team reward for every robot ('team'), or local rewards summing to it ('local')."""
+        if self._engine is not None:
+            engine = self._engine
+            if engine.robot_reward is None:
+                return np.repeat(engine.reward[:, None], self.config.num_robots, axis=1)
+            return engine.robot_reward.copy()
+        return self._robot_reward.copy()
 
     def task_performance(self) -> np.ndarray:
         """(W,) paper eq. 1 of each world's episode so far (final once it has ended)."""

@@ -78,4 +78,113 @@ def test_policy_of_wrong_observation_size_is_refused(tmp_path, capsys):
 
 def test_unknown_policy_spec(capsys):
     assert compare_main(["--policy", "genius"]) == 2
-    assert "allowed: random, heuristic" in capsys.readouterr().err
+    assert "allowed: random, heuristic, wander" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------- GatheringVecEnv
+def test_vecenv_matches_vector_simulation_and_auto_resets():
+    """Sub-env k = robot k % N of world k // N; ends, infos and auto-reset as documented."""
+    from gathering_env.sb3 import SEED_LIMIT, GatheringVecEnv
+    from gathering_env.vector import VectorSimulation
+
+    options = dict(environment=1, num_robots=3, max_cycles=25, reward="shaped", reward_scope="local")
+    venv = GatheringVecEnv(2, seed=11, **options)
+    assert venv.num_envs == 6 and venv.observation_space.shape == (6,) and venv.action_space.shape == (2,)
+    draws = np.random.default_rng(11).integers(0, SEED_LIMIT, 4)       # the episode seeds it will use
+    reference = VectorSimulation(2, **options)
+    ref_obs = reference.reset([int(draws[0]), int(draws[1])])
+    obs = venv.reset()
+    np.testing.assert_array_equal(obs, ref_obs.reshape(6, -1))
+    rng = np.random.default_rng(0)
+    team_return = np.zeros(2)
+    for t in range(25):
+        actions = rng.uniform(-1, 1, (6, 2)).astype(np.float32)
+        obs, rewards, dones, infos = venv.step(actions)
+        ref_obs, ref_team, _, ref_trunc = reference.step(actions.reshape(2, 3, 2).astype(np.float64))
+        team_return += ref_team
+        np.testing.assert_allclose(rewards, reference.robot_rewards().reshape(-1), rtol=1e-6, atol=1e-6)
+        if t < 24:
+            assert not dones.any() and infos == [{}] * 6
+            np.testing.assert_array_equal(obs, ref_obs.reshape(6, -1))
+    assert dones.all() and ref_trunc.all()
+    ft = reference.task_performance()
+    for k, info in enumerate(infos):
+        w, i = divmod(k, 3)
+        np.testing.assert_array_equal(info["terminal_observation"], ref_obs[w, i])
+        assert info["task_performance"] == ft[w] and info["TimeLimit.truncated"] is True
+        assert info["team_return"] == pytest.approx(team_return[w])
+    for w in range(2):       # auto-reset: world w's next episode started from the next drawn seed
+        np.testing.assert_array_equal(obs[3 * w:3 * w + 3], reference.reset_world(w, int(draws[2 + w])))
+
+
+def test_vecenv_seed_makes_runs_reproducible():
+    from gathering_env.sb3 import GatheringVecEnv
+
+    def trace(venv):
+        rng, out = np.random.default_rng(1), [venv.reset()]
+        for _ in range(30):
+            out.append(venv.step(rng.uniform(-1, 1, (venv.num_envs, 2)).astype(np.float32))[0])
+        return np.stack(out)
+
+    a, b = GatheringVecEnv(2, environment=1, num_robots=2, max_cycles=12), GatheringVecEnv(2, environment=1,
+                                                                                              num_robots=2, max_cycles=12)
+    assert a.seed(5) == [5] * 4
+    b.seed(5)
+    np.testing.assert_array_equal(trace(a), trace(b))         # across auto-resets too (30 > 2 x 12 steps)
+    b.seed(6)
+    assert not np.array_equal(trace(a.__class__(2, seed=5, environment=1, num_robots=2, max_cycles=12)), trace(b))
+    with pytest.raises(ValueError, match=r"seed=-1; allowed: a non-negative integer or None"):
+        a.seed(-1)
+
+
+def test_vecenv_passes_sb3_checks_and_trains_ppo(tmp_path):
+    """SB3's checks that apply: check_env on the equivalent single env (one world of one robot
+    is the centralised team env), VecCheckNan/VecMonitor/VecNormalize around the VecEnv,
+    PPO learning a few hundred steps, saving and reloading."""
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+    from stable_baselines3.common.vec_env import VecCheckNan, VecMonitor, VecNormalize
+
+    from gathering_env.sb3 import GatheringVecEnv
+
+    single = gymnasium.make(TEAM_ENV_ID, environment=1, num_robots=1, max_cycles=30, reward="shaped")
+    sb3_check_env(single.unwrapped)
+    venv = GatheringVecEnv(2, seed=0, environment=1, num_robots=4, max_cycles=40, reward="shaped",
+                           reward_scope="local")
+    assert venv.observation_space == single.observation_space and venv.action_space == single.action_space
+    wrapped = VecNormalize(VecMonitor(VecCheckNan(venv, raise_exception=True)), norm_reward=True)
+    model = sb3.PPO("MlpPolicy", wrapped, n_steps=40, batch_size=80, n_epochs=1, seed=0, device="cpu")
+    model.learn(total_timesteps=8 * 40 * 2)
+    assert model.num_timesteps == 640 and len(model.ep_info_buffer) == 16    # 2 worlds x 4 robots x 2 episodes
+    model.save(tmp_path / "model.zip")
+    again = sb3.PPO.load(tmp_path / "model.zip", device="cpu")
+    obs = np.random.default_rng(0).uniform(0, 1, (8, 6)).astype(np.float32)
+    np.testing.assert_array_equal(model.predict(obs, deterministic=True)[0], again.predict(obs, deterministic=True)[0])
+    with pytest.raises(ValueError, match=r"reward_scope='all'; allowed: 'team', 'local'"):
+        GatheringVecEnv(1, environment=1, reward_scope="all")
+
+
+def test_compare_wander_runs(tmp_path, capsys):
+    assert compare_main(["--policy", "wander", "--policy", "random", "--environment", "1", "--steps", "300",
+                         "--robots", "10", "--episodes", "2", "--seed", "9", "--out", str(tmp_path)]) == 0
+    rows = {r.split(",")[0]: r.split(",") for r in (tmp_path / "compare.csv").read_text().splitlines()[1:]}
+    assert set(rows) == {"wander", "random"} and rows["wander"][1] == "6"
+
+
+def test_ppo_sample_policy_is_seeded_and_differs_from_the_mean(tmp_path):
+    from evolution.compare import compare, make_policy
+
+    env = parallel_env(environment=1, num_robots=3, max_cycles=20)
+    env.reset(seed=0)
+    vec = ss.concat_vec_envs_v1(ss.pettingzoo_env_to_vec_env_v1(env), 1, num_cpus=0, base_class="stable_baselines3")
+    sb3.PPO("MlpPolicy", vec, n_steps=16, batch_size=48, device="cpu").save(tmp_path / "tiny.zip")
+    sample, mean = make_policy(f"ppo-sample:{tmp_path / 'tiny.zip'}"), make_policy(f"ppo:{tmp_path / 'tiny.zip'}")
+    assert sample.name == "ppo-sample:tiny" and mean.name == "ppo:tiny"
+    obs = np.full((3, 6), 0.5, np.float32)
+    sample.reset(7)
+    first = sample.act(obs)
+    sample.reset(7)
+    np.testing.assert_array_equal(sample.act(obs), first)               # seeded by the episode seed
+    assert not np.array_equal(first, mean.act(obs))
+    np.testing.assert_array_equal(mean.act(obs), mean.act(obs))         # the mean is deterministic
+    rows = compare([sample, sample], {"environment": 1, "max_cycles": 30, "num_robots": 3}, [1, 2])
+    assert rows[0]["ft_mean"] == rows[1]["ft_mean"]

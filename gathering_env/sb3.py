@@ -1,0 +1,147 @@
+"""The W-world simulation as a Stable-Baselines3 ``VecEnv``: one sub-environment per robot.
+
+Every robot of every world is one sub-environment, so a single SB3 policy (PPO, A2C, ...)
+is shared by the whole team and trained on all robots' experience at once::
+
+    from stable_baselines3 import PPO
+    from gathering_env.sb3 import GatheringVecEnv
+
+    venv = GatheringVecEnv(num_worlds=4, seed=0, environment=1, max_cycles=2000, reward="shaped")
+    model = PPO("MlpPolicy", venv).learn(200_000)       # timesteps count robot-steps
+
+Sub-environment ``k`` is robot ``k % N`` of world ``k // N`` (W worlds of N robots:
+``num_envs = W * N``). Observation ``Box(0, 1, (S,), float32)`` (the morphology's
+readings), action ``Box(-1, 1, (2,), float32)`` (left, right wheel). Rewards are
+``VectorSimulation.robot_rewards()`` (``reward`` / ``attach_reward`` / ``reward_scope``
+world options; see ``gathering_env.rewards``).
+
+When a world's episode ends, its N sub-environments report ``done`` together, their infos
+carry ``terminal_observation``, ``TimeLimit.truncated`` and the episode's
+``task_performance`` (ft, paper eq. 1), ``blocks_gathered`` and ``team_return`` (the sum of
+the world's team rewards), and the world starts a new episode (auto-reset). Episode seeds
+are drawn from one generator seeded by ``seed`` (constructor or ``seed()``, applied at the
+next ``reset()``), so training runs are reproducible.
+
+Needs Stable-Baselines3 (``pip install 'gathering-evolution[rl]'``); nothing else in the
+package imports this module.
+"""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvIndices
+
+from .sensors import Morphology
+from .vector import VectorSimulation
+
+SEED_LIMIT = 2**31
+"""Episode seeds are drawn uniformly from [0, SEED_LIMIT)."""
+
+
+class GatheringVecEnv(VecEnv):
+    """W worlds x N robots as ``W * N`` SB3 sub-environments (see the module docstring).
+
+    Args:
+        num_worlds: W worlds stepped together (``VectorSimulation``).
+        seed: seeds the generator of episode seeds (None: fresh entropy).
+        morphology: every robot's sensor suite (default Khepera III).
+        **world_parameters: ``WorldConfig.from_kwargs`` arguments (``environment``,
+            ``max_cycles``, ``num_robots``, ``reward``, ``reward_scope``, ...).
+    """
+
+    render_mode = None
+
+    def __init__(self, num_worlds: int = 1, seed: int | None = None,
+                 morphology: Morphology | Sequence | dict | None = None, **world_parameters: Any) -> None:
+        self.sim = VectorSimulation(num_worlds, morphology=morphology, **world_parameters)
+        self.config = self.sim.config
+        self.num_worlds, self.num_robots = self.sim.num_worlds, self.config.num_robots
+        observation_space = spaces.Box(0.0, 1.0, shape=(len(self.sim.morphology),), dtype=np.float32)
+        action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
+        super().__init__(self.num_worlds * self.num_robots, observation_space, action_space)
+        self._seed = _check_seed(seed)
+        self._rng = np.random.default_rng(self._seed)
+        self._actions: np.ndarray | None = None
+        self._team_return = np.zeros(self.num_worlds)
+
+    # ------------------------------------------------------------------ VecEnv API
+    def seed(self, seed: int | None = None) -> list[int | None]:
+        """Seed the episode-seed generator; takes effect at the next ``reset()``."""
+        self._seed = _check_seed(seed)
+        self._rng = np.random.default_rng(self._seed)
+        return [self._seed] * self.num_envs
+
+    def reset(self) -> np.ndarray:
+        obs = self.sim.reset(self._episode_seeds(self.num_worlds))
+        self._team_return[:] = 0.0
+        self.reset_infos = [{} for _ in range(self.num_envs)]
+        return obs.reshape(self.num_envs, -1)
+
+    def step_async(self, actions: np.ndarray) -> None:
+        self._actions = np.asarray(actions)
+
+    def step_wait(self):
+        if self._actions is None:
+            raise RuntimeError("step_wait() without step_async(actions)")
+        wheels = self._actions.reshape(self.num_worlds, self.num_robots, 2)
+        self._actions = None
+        obs, team, terminated, truncated = self.sim.step(wheels)
+        rewards = self.sim.robot_rewards().reshape(-1).astype(np.float32)
+        self._team_return += team
+        ended = terminated | truncated
+        dones = np.repeat(ended, self.num_robots)
+        infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
+        if ended.any():
+            ft = self.sim.task_performance()
+            gathered = self.sim.blocks_gathered_by_type()
+            for w in np.flatnonzero(ended):
+                episode = {"task_performance": float(ft[w]), "blocks_gathered": gathered[w].tolist(),
+                           "team_return": float(self._team_return[w]),
+                           "TimeLimit.truncated": bool(truncated[w] and not terminated[w])}
+                for i in range(self.num_robots):
+                    infos[w * self.num_robots + i] = dict(episode, terminal_observation=obs[w, i].copy())
+                obs[w] = self.sim.reset_world(int(w), self._episode_seeds(1)[0])
+                self._team_return[w] = 0.0
+        return obs.reshape(self.num_envs, -1), rewards, dones, infos
+
+    def close(self) -> None:
+        pass
+
+    def get_attr(self, attr_name: str, indices: VecEnvIndices = None) -> list[Any]:
+        return [getattr(self, attr_name)] * len(self._indices(indices))
+
+    def set_attr(self, attr_name: str, value: Any, indices: VecEnvIndices = None) -> None:
+        raise AttributeError(f"set_attr({attr_name!r}): the sub-environments share one simulation; "
+                             "allowed: none (build a new GatheringVecEnv)")
+
+    def env_method(self, method_name: str, *method_args, indices: VecEnvIndices = None, **method_kwargs) -> list[Any]:
+        raise AttributeError(f"env_method({method_name!r}): the sub-environments are robots of a shared "
+                             "simulation, not separate envs; call methods of GatheringVecEnv.sim instead")
+
+    def env_is_wrapped(self, wrapper_class: type, indices: VecEnvIndices = None) -> list[bool]:
+        return [False] * len(self._indices(indices))
+
+    # ------------------------------------------------------------------ helpers
+    def _episode_seeds(self, count: int) -> list[int]:
+        return [int(s) for s in self._rng.integers(0, SEED_LIMIT, count)]
+
+    def _indices(self, indices: VecEnvIndices) -> list[int]:
+        if indices is None:
+            return list(range(self.num_envs))
+        if isinstance(indices, numbers.Integral):
+            return [int(indices)]
+        return list(indices)
+
+
+def _check_seed(seed: Any) -> int | None:
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0):
+        raise ValueError(f"seed={seed!r}; allowed: a non-negative integer or None")
+    return None if seed is None else int(seed)
+
+
+__all__ = ["GatheringVecEnv"]
