@@ -121,8 +121,9 @@ def _evaluate_in_worker(genome: Any, generation: int, attempt: int) -> Evaluatio
 class ProcessEvaluator:
     """Evaluate genomes on ``workers`` local processes.
 
-    A worker that dies breaks the pool: the pool is rebuilt and the unfinished genomes are
-    submitted again (each such restart counts as an attempt for every genome in flight).
+    A worker that dies breaks the pool: the pool is rebuilt, and the genomes that were in it
+    are retried one at a time, so that a death counts as an attempt of the genome that caused
+    it and of no other.
     """
 
     name = "process"
@@ -144,30 +145,49 @@ class ProcessEvaluator:
     def map(self, genomes: list[Any], generation: int) -> list[Evaluation]:
         results: list[Evaluation | None] = [None] * len(genomes)
         attempts = [0] * len(genomes)
+        isolated: set[int] = set()   # caught in a broken pool: retried one at a time
         pending = list(range(len(genomes)))
+
+        def charge(i: int, error: str, retry: list[int]) -> None:
+            attempts[i] += 1
+            if attempts[i] > self.max_retries:
+                self.failures.append((genomes[i].key, error))
+                results[i] = Evaluation.failure(error)
+            else:
+                retry.append(i)
+
         while pending:
-            futures = {i: self._pool.submit(_evaluate_in_worker, genomes[i], generation, attempts[i]) for i in pending}
             retry: list[int] = []
+            together = [i for i in pending if i not in isolated]
+            futures = {i: self._pool.submit(_evaluate_in_worker, genomes[i], generation, attempts[i])
+                       for i in together}
             broken = False
             for i, fut in futures.items():
                 try:
                     results[i] = fut.result()
-                    continue
-                except BrokenProcessPool as err:
-                    broken, error = True, f"worker process died: {_describe(err)}"
-                except Exception as err:  # noqa: BLE001 - evaluation errors come back from the worker
-                    error = _describe(err)
-                attempts[i] += 1
-                if attempts[i] > self.max_retries:
-                    self.failures.append((genomes[i].key, error))
-                    results[i] = Evaluation.failure(error)
-                else:
+                except BrokenProcessPool:
+                    # which genome killed the worker is unknown: charge nobody, isolate them all
+                    broken = True
+                    isolated.add(i)
                     retry.append(i)
+                except Exception as err:  # noqa: BLE001 - evaluation errors come back from the worker
+                    charge(i, _describe(err), retry)
             if broken:
-                self._pool.shutdown(wait=False, cancel_futures=True)
-                self._pool = self._new_pool()
+                self._renew_pool()
+            for i in (i for i in pending if i in isolated and i not in futures):
+                try:
+                    results[i] = self._pool.submit(_evaluate_in_worker, genomes[i], generation, attempts[i]).result()
+                except BrokenProcessPool as err:
+                    self._renew_pool()
+                    charge(i, f"worker process died: {_describe(err)}", retry)
+                except Exception as err:  # noqa: BLE001
+                    charge(i, _describe(err), retry)
             pending = retry
         return results  # type: ignore[return-value]
+
+    def _renew_pool(self) -> None:
+        self._pool.shutdown(wait=False, cancel_futures=True)
+        self._pool = self._new_pool()
 
     def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)

@@ -94,6 +94,26 @@ def test_persistent_failure_gives_worst_fitness_and_is_logged(tmp_path, monkeypa
     assert "generation 0 genome 3: RuntimeError: this genome always breaks" in log
 
 
+def test_a_genome_that_kills_its_worker_is_the_only_one_charged(tmp_path, monkeypatch, reference):
+    """Worker deaths are charged to the genome that causes them, not to the others in the pool."""
+    exp, _ = reference
+    original = backends.EvalContext.evaluate
+
+    def evaluate(self, genome, generation):
+        if genome.key in (3, 4, 5):
+            os._exit(3)                                # these genomes always kill their worker
+        return original(self, genome, generation)
+
+    monkeypatch.setattr(backends.EvalContext, "evaluate", evaluate)
+    assert evolve_main([str(exp), "--out", str(tmp_path / "run"), "--backend", "process", "--workers", "2",
+                        "--max-retries", "1", "--generations", "1", "--no-progress"]) == 0
+    records = read_stats(tmp_path / "run" / "stats.jsonl")
+    assert records[0]["failures"] == 3                 # exactly the three killers, each after 2 attempts
+    log = (tmp_path / "run" / "errors.log").read_text()
+    assert sorted(int(line.split("genome ")[1].split(":")[0]) for line in log.splitlines()
+                  if line.startswith("generation 0 genome")) == [3, 4, 5]
+
+
 def run_cli(args: list[str]) -> subprocess.Popen:
     env = dict(os.environ, SDL_VIDEODRIVER="dummy", PYTHONPATH=str(ROOT))
     return subprocess.Popen([sys.executable, "-m", "evolution", *args], cwd=ROOT, env=env,
