@@ -49,7 +49,7 @@ def plot_curves(runs: list[Path], evolution: dict, path: Path, environment: int)
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.0, 4.0), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(10.0, 4.0), constrained_layout=True)
     for run in runs:
         steps, ft = read_curve(run)
         if len(ft) == 0:
@@ -65,7 +65,7 @@ def plot_curves(runs: list[Path], evolution: dict, path: Path, environment: int)
     ax.set_ylabel("ft of training episodes (2 000 steps)")
     ax.set_title(f"PPO learning curves, environment {environment}", fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
