@@ -126,8 +126,11 @@ def ppo_policy(path: str, sample: bool = False) -> Policy:
 
             torch.manual_seed(seed)
 
-    # SB3 saves "model.zip" by default: name such a model after its run directory instead.
-    label = model_path.parent.name if model_path.stem == "model" and model_path.parent.name else model_path.stem
+    # SB3 saves "model.zip" by default: name such a model after its run directory instead, and
+    # a snapshot of rl_ppo.py (model-ENV_STEPS.zip) after its run and budget.
+    label = model_path.stem
+    if model_path.parent.name and (label == "model" or label.startswith("model-")):
+        label = model_path.parent.name + label[len("model"):].replace("-", "@", 1)
     return Policy(f"{'ppo-sample' if sample else 'ppo'}:{label}", morphology, act, reset)
 
 

@@ -13,7 +13,8 @@ the task's own sparse reward.
 
 Budgets count environment steps (one step of one world of N robots = N robot-steps, what
 SB3 calls timesteps); ``--max-minutes`` stops earlier on wall-clock. Writes into ``--out``:
-``model.zip`` (the policy), ``model.morphology.json`` (its sensors), ``progress.csv`` (SB3's
+``model.zip`` (the policy), ``model.morphology.json`` (its sensors), ``model-ENV_STEPS.zip``
+for every ``--snapshots`` budget (the policy as it was then), ``progress.csv`` (SB3's
 log, plus ``rollout/ft_mean`` and ``rollout/team_return_mean``), ``curve.csv`` (one row per
 finished training episode: env steps, minutes, ft, team return), ``curve.png`` (ft and team
 return vs environment steps) and ``evaluation.json`` (ft over ``--eval-episodes`` held-out
@@ -37,7 +38,7 @@ import torch  # noqa: E402
 from stable_baselines3 import PPO  # noqa: E402
 from stable_baselines3.common.callbacks import BaseCallback  # noqa: E402
 from stable_baselines3.common.logger import configure  # noqa: E402
-from stable_baselines3.common.vec_env import VecMonitor  # noqa: E402
+from stable_baselines3.common.vec_env import VecMonitor, VecNormalize  # noqa: E402
 
 from evolution.compare import compare, ppo_policy  # noqa: E402
 from gathering_env import Morphology  # noqa: E402
@@ -51,14 +52,18 @@ EVAL_SEED = 10_000
 class EpisodeLog(BaseCallback):
     """Records ft and the team's (shaped) return of every finished training episode."""
 
-    def __init__(self, path: Path, num_robots: int, max_minutes: float | None) -> None:
+    def __init__(self, path: Path, num_robots: int, max_minutes: float | None,
+                 snapshots: list[int] = (), morphology: Morphology | None = None) -> None:
         super().__init__()
         self.path, self.num_robots, self.max_minutes = path, num_robots, max_minutes
+        self.snapshots, self.morphology = sorted(snapshots), morphology
         self.rows: list[dict] = []
         self.start = time.perf_counter()
 
     def _on_step(self) -> bool:
         minutes = (time.perf_counter() - self.start) / 60
+        while self.snapshots and self.num_timesteps // self.num_robots >= self.snapshots[0]:
+            save_model(self.model, self.path.parent / f"model-{self.snapshots.pop(0)}.zip", self.morphology)
         for k, info in enumerate(self.locals["infos"]):
             if k % self.num_robots == 0 and "task_performance" in info:   # one row per world
                 self.rows.append({"env_steps": self.num_timesteps // self.num_robots, "minutes": round(minutes, 3),
@@ -77,6 +82,12 @@ class EpisodeLog(BaseCallback):
             writer = csv.DictWriter(f, fieldnames=["env_steps", "minutes", "ft", "team_return"])
             writer.writeheader()
             writer.writerows(self.rows)
+
+
+def save_model(model: PPO, path: Path, morphology: Morphology) -> None:
+    """The policy and, next to it, its morphology (what ``gathering-compare --policy ppo:PATH`` reads)."""
+    model.save(path)
+    path.with_suffix(".morphology.json").write_text(json.dumps(morphology.to_dict(), indent=1))
 
 
 def plot_curve(rows: list[dict], path: Path, title: str) -> None:
@@ -121,11 +132,20 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--env-steps", type=int, default=500_000, help="training budget in environment steps")
     p.add_argument("--timesteps", type=int, default=None,
                    help="training budget in robot-steps (SB3 timesteps) instead of --env-steps")
+    p.add_argument("--snapshots", type=int, nargs="*", default=[], metavar="ENV_STEPS",
+                   help="also save the policy as model-ENV_STEPS.zip when training passes these budgets "
+                        "(e.g. an evolution run's budget, to compare at equal environment steps)")
     p.add_argument("--max-minutes", type=float, default=None, help="stop training after this many minutes")
     p.add_argument("--n-steps", type=int, default=256, help="PPO rollout length per sub-environment")
     p.add_argument("--gamma", type=float, default=0.99)
     p.add_argument("--ent-coef", type=float, default=0.01,
                    help="entropy bonus (default 0.01; with 0 training collapsed, see docs/rl/README.md)")
+    p.add_argument("--log-std-init", type=float, default=0.0,
+                   help="initial log standard deviation of the Gaussian action noise (SB3 default 0)")
+    p.add_argument("--n-epochs", type=int, default=4)
+    p.add_argument("--learning-rate", type=float, default=3e-4)
+    p.add_argument("--norm-reward", action="store_true",
+                   help="scale rewards by a running estimate of the return's std (SB3 VecNormalize, rewards only)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--eval-episodes", type=int, default=5)
     p.add_argument("--out", type=Path, default=Path("runs/ppo"))
@@ -147,13 +167,16 @@ def main(argv: list[str] | None = None) -> None:
     world = {"environment": args.environment, "num_robots": args.robots, "max_cycles": args.steps,
              "reward": args.reward, "attach_reward": args.attach_reward, "reward_scope": args.reward_scope}
     venv = VecMonitor(GatheringVecEnv(args.worlds, seed=args.seed, morphology=morphology, **world))
+    if args.norm_reward:
+        venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=args.gamma)
 
     # 3. PPO with one shared policy; logs to stdout and CSV.
     model = PPO("MlpPolicy", venv, n_steps=args.n_steps, batch_size=min(2048, args.n_steps * venv.num_envs),
-                n_epochs=4, learning_rate=3e-4, gamma=args.gamma, gae_lambda=0.95, ent_coef=args.ent_coef,
+                n_epochs=args.n_epochs, learning_rate=args.learning_rate, gamma=args.gamma, gae_lambda=0.95,
+                ent_coef=args.ent_coef, policy_kwargs={"log_std_init": args.log_std_init},
                 seed=args.seed, verbose=1, device="cpu")
     model.set_logger(configure(str(args.out), ["stdout", "csv"]))
-    log = EpisodeLog(args.out / "curve.csv", args.robots, args.max_minutes)
+    log = EpisodeLog(args.out / "curve.csv", args.robots, args.max_minutes, args.snapshots, morphology)
     start = time.perf_counter()
     budget = args.timesteps if args.timesteps is not None else args.env_steps * args.robots
     model.learn(total_timesteps=budget, callback=log, progress_bar=False)
@@ -161,8 +184,7 @@ def main(argv: list[str] | None = None) -> None:
     log.save()
     env_steps = model.num_timesteps // args.robots
     model_path = args.out / "model.zip"
-    model.save(model_path)
-    (args.out / "model.morphology.json").write_text(json.dumps(morphology.to_dict(), indent=1))
+    save_model(model, model_path, morphology)
     title = (f"PPO env {args.environment}, reward={args.reward} ({args.reward_scope}), {args.worlds} worlds x "
              f"{args.robots} robots, {args.steps}-step episodes")
     plot_curve(log.rows, args.out / "curve.png", title)

@@ -188,3 +188,30 @@ def test_ppo_sample_policy_is_seeded_and_differs_from_the_mean(tmp_path):
     np.testing.assert_array_equal(mean.act(obs), mean.act(obs))         # the mean is deterministic
     rows = compare([sample, sample], {"environment": 1, "max_cycles": 30, "num_robots": 3}, [1, 2])
     assert rows[0]["ft_mean"] == rows[1]["ft_mean"]
+
+
+def test_rl_ppo_example_trains_saves_snapshots_and_evaluates(tmp_path):
+    """examples/rl_ppo.py end to end on a tiny budget: every output file, a snapshot at the asked
+    budget that gathering-compare loads (named after run and budget), the evaluation report."""
+    import importlib.util
+    from pathlib import Path
+
+    from evolution.compare import make_policy
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "rl_ppo.py"
+    spec = importlib.util.spec_from_file_location("rl_ppo_example", path)
+    rl_ppo = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(rl_ppo)
+    out = tmp_path / "run"
+    rl_ppo.main(["--environment", "1", "--robots", "3", "--worlds", "2", "--steps", "40", "--env-steps", "160",
+                 "--n-steps", "20", "--reward-scope", "local", "--norm-reward", "--log-std-init", "-0.5",
+                 "--snapshots", "40", "--eval-episodes", "2", "--out", str(out)])
+    for name in ("model.zip", "model.morphology.json", "model-40.zip", "model-40.morphology.json",
+                 "curve.csv", "curve.png", "evaluation.json", "progress.csv"):
+        assert (out / name).is_file(), name
+    report = json.loads((out / "evaluation.json").read_text())
+    assert report["env_steps"] == 160 and report["robot_steps"] == 480 and report["eval_seeds"] == [10_000, 10_001]
+    assert len((out / "curve.csv").read_text().splitlines()) == 1 + 160 // 40   # header + one row per episode
+    snapshot = make_policy(f"ppo-sample:{out / 'model-40.zip'}")
+    assert snapshot.name == "ppo-sample:run@40" and len(snapshot.morphology) == 6
+    assert make_policy(f"ppo:{out / 'model.zip'}").name == "ppo:run"
