@@ -11,15 +11,23 @@ the quick evolution run (``CHAMPION/champion.json``, ``stats.csv``), runs
   champion, the PPO runs of that environment);
 * ``curves-env<E>.png``: ft of the training episodes vs environment steps of every PPO run,
   with the evolution run's budget and best training ft marked;
+* ``paired-env1-<steps>.md``: environment 1 on more held-out seeds (``--paired-seeds``, default
+  40 for 2 000 steps and 20 for 10 000), every policy on the same seeds, with the paired
+  difference to ``wander`` and to the champion (mean ± standard error of the per-seed
+  differences) and the Wilcoxon signed-rank p-value (scipy) — which differences are more than
+  noise; PPO snapshots (``model-ENV_STEPS.zip``) are included, so PPO is also compared at the
+  evolution run's budget;
 * ``budgets.md``: training budget of each trained policy in environment steps and minutes;
 * ``summary.md``: ft of every policy in every setting in one table;
-* ``rows.json``: every policy's row, computed once (rerun after more runs finish).
+* ``rows.json``: every policy's row, computed once per model file content (rerun after more
+  runs finish; a retrained model is evaluated again).
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import hashlib
 import json
 import os
 from pathlib import Path
@@ -29,9 +37,20 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
 import numpy as np  # noqa: E402
 
-from evolution.compare import compare, make_policy, write_outputs  # noqa: E402
+from evolution.compare import compare, make_policy, run_episode, write_outputs  # noqa: E402
+from gathering_env import parallel_env  # noqa: E402
 
 SEEDS = list(range(10_000, 10_005))
+PAIRED = {2000: 40, 10_000: 20}
+"""Episode length -> number of held-out seeds (10 000 onwards) of the paired comparison."""
+
+
+def cache_key(spec: str, *parts: object) -> str:
+    """A policy's cache key: its spec plus, for a trained policy, a digest of the model file,
+    so a retrained model at the same path is evaluated again."""
+    kind, _, path = spec.partition(":")
+    digest = hashlib.sha1(Path(path).read_bytes()).hexdigest()[:10] if kind.startswith("ppo") else ""
+    return "|".join([spec + (f"#{digest}" if digest else ""), *map(str, parts)])
 
 
 def ppo_runs(runs: Path, environment: int) -> list[Path]:
@@ -84,6 +103,8 @@ def write_summary(cache: dict, path: Path, steps_list: list[int]) -> None:
     columns = [(e, n) for e in (1, 2) for n in steps_list]
     names: dict[str, dict] = {}
     for key, row in cache.items():
+        if key.count("|") != 2:
+            continue                      # the paired comparison's per-episode lists
         spec, env, steps = key.split("|")
         names.setdefault(row["policy"], {})[(int(env[3:]), int(steps))] = row
     header = "| policy | " + " | ".join(f"env {e}, {n:,} steps" for e, n in columns) + " |"
@@ -94,6 +115,42 @@ def write_summary(cache: dict, path: Path, steps_list: list[int]) -> None:
     path.write_text("ft (mean ± std over the 5 held-out episodes, seeds 10 000..10 004)\n\n" + "\n".join(lines) + "\n")
 
 
+def paired_episodes(spec: str, environment: int, steps: int, seeds: list[int], cache: dict, cache_path: Path
+                    ) -> np.ndarray:
+    key = cache_key(spec, f"env{environment}", steps, f"seeds{seeds[0]}-{seeds[-1]}")
+    if key not in cache:
+        env = parallel_env(environment=environment, max_cycles=steps, num_robots=20)
+        policy = make_policy(spec)
+        cache[key] = {"policy": policy.name, "ft": [run_episode(env, policy, s)["ft"] for s in seeds]}
+        cache_path.write_text(json.dumps(cache, indent=1))
+    return cache[key]
+
+
+def write_paired(entries: list[dict], path: Path, environment: int, steps: int, seeds: list[int]) -> None:
+    """Mean ± standard error per policy; paired differences to wander and the champion with the
+    Wilcoxon signed-rank p-value (two-sided; '—' when every difference is 0)."""
+    from scipy.stats import wilcoxon
+
+    by_name = {e["policy"]: np.array(e["ft"]) for e in entries}
+    refs = [name for name in by_name if name == "wander" or name.startswith("champion:")]
+
+    def versus(ft: np.ndarray, ref: np.ndarray) -> str:
+        d = ft - ref
+        if not d.any():
+            return "— | —"
+        return f"{d.mean():+.2f} ± {d.std(ddof=1) / np.sqrt(len(d)):.2f} | {wilcoxon(ft, ref).pvalue:.2g}"
+
+    lines = [f"environment {environment}, 20 robots, {steps:,}-step episodes, {len(seeds)} held-out seeds "
+             f"({seeds[0]}..{seeds[-1]}), every policy on the same seeds; ± is the standard error; p: "
+             "Wilcoxon signed-rank test of the per-seed differences (two-sided)", "",
+             "| policy | ft | " + " | ".join(f"vs {r}: difference | p" for r in refs) + " |",
+             "|---|---|" + "---|---|" * len(refs)]
+    for name, ft in by_name.items():
+        cells = " | ".join(versus(ft, by_name[r]) if r != name else "— | —" for r in refs)
+        lines.append(f"| {name} | {ft.mean():.2f} ± {ft.std(ddof=1) / np.sqrt(len(ft)):.2f} | {cells} |")
+    path.write_text("\n".join(lines) + "\n")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--runs", type=Path, default=Path("out/rl"))
@@ -101,6 +158,9 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("docs/rl"))
     parser.add_argument("--steps", type=int, nargs="+", default=[2000, 10_000])
     parser.add_argument("--only-baselines", action="store_true", help="fill the cache with the baselines' rows")
+    parser.add_argument("--paired-seeds", nargs="+", default=None, metavar="STEPS=SEEDS",
+                        help="episode length=seed count of the paired comparison in environment 1 "
+                             f"(default {' '.join(f'{k}={v}' for k, v in PAIRED.items())})")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     cache_path = args.out / "rows.json"
@@ -122,7 +182,7 @@ def main() -> None:
         for steps in args.steps:
             rows = []
             for spec in specs:
-                key = f"{spec}|env{environment}|{steps}"
+                key = cache_key(spec, f"env{environment}", steps)
                 if key not in cache:    # a policy's row is computed once; delete rows.json to redo
                     config = {"environment": environment, "max_cycles": steps, "num_robots": 20}
                     cache[key] = compare([make_policy(spec)], config, SEEDS)[0]
@@ -134,6 +194,17 @@ def main() -> None:
             for src, suffix in ((md, "md"), (csv_path, "csv"), (png, "png")):
                 src.replace(args.out / f"compare-env{environment}-{steps}.{suffix}")
             print((args.out / f"compare-env{environment}-{steps}.md").read_text())
+        if environment == 1:
+            paired = dict(PAIRED) if args.paired_seeds is None else dict(map(int, x.split("=")) for x in args.paired_seeds)
+            snapshots = [p for run in runs for p in sorted(run.glob("model-*.zip"))]
+            specs_paired = ["random", "wander", f"champion:{args.champion / 'champion.json'}"]
+            specs_paired += [f"{kind}:{model}" for model in [run / "model.zip" for run in runs] + snapshots
+                             for kind in ("ppo-sample", "ppo")]
+            for steps, count in paired.items():
+                seeds = list(range(SEEDS[0], SEEDS[0] + count))
+                entries = [paired_episodes(spec, 1, steps, seeds, cache, cache_path) for spec in specs_paired]
+                write_paired(entries, args.out / f"paired-env1-{steps}.md", 1, steps, seeds)
+                print((args.out / f"paired-env1-{steps}.md").read_text())
     (args.out / "tmp").rmdir()
     write_summary(cache, args.out / "summary.md", args.steps)
     (args.out / "budgets.md").write_text("\n".join(budgets) + "\n")
