@@ -17,7 +17,8 @@ Policies (each carries the morphology it was made for):
 * ``champion:PATH``: an evolved team from a champion JSON (its own morphology).
 * ``ppo:PATH``: a Stable-Baselines3 PPO model (``examples/rl_ppo.py``) with the morphology
   saved next to it (``PATH`` with suffix ``.morphology.json``), Khepera III if absent; its
-  deterministic actions (the policy's mean).
+  deterministic actions (the policy's mean; with discrete wheel commands, ``wheel_levels``,
+  each wheel's most likely command).
 * ``ppo-sample:PATH``: the same model with actions sampled from its distribution, as in
   training (torch's generator seeded by the episode seed).
 """
@@ -88,7 +89,8 @@ def champion_policy(path: str) -> Policy:
 
 
 def ppo_policy(path: str, sample: bool = False) -> Policy:
-    """A saved SB3 model; deterministic actions (the policy's mean), or with ``sample`` actions
+    """A saved SB3 model (continuous or discrete wheel commands, as its action space says);
+    deterministic actions (the policy's mean / most likely command), or with ``sample`` actions
     drawn from the policy's distribution (torch's generator seeded by the episode seed)."""
     try:
         from stable_baselines3 import PPO
@@ -116,9 +118,11 @@ def ppo_policy(path: str, sample: bool = False) -> Policy:
         raise ValueError(f"{model_path}: the policy expects observations of shape {expected}, but its morphology "
                          f"has {len(morphology)} sensors; save the morphology as {morph_path.name}")
 
+    from gathering_env.sb3 import wheel_commands
+
     def act(obs):
         action, _ = model.predict(obs.astype(np.float32), deterministic=not sample)
-        return np.asarray(action, dtype=np.float64).reshape(obs.shape[0], 2)
+        return wheel_commands(action, model.action_space).reshape(obs.shape[0], 2)
 
     def reset(seed):
         if sample:

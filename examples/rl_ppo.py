@@ -128,6 +128,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--attach-reward", type=float, default=WorldConfig.attach_reward,
                    help=f"bonus per attachment with --reward shaped (default {WorldConfig.attach_reward})")
     p.add_argument("--reward-scope", choices=REWARD_SCOPES, default="team")
+    p.add_argument("--wheel-levels", type=int, default=None, metavar="K",
+                   help="discrete actions: K evenly spaced commands per wheel (MultiDiscrete([K, K]); "
+                        "default: continuous wheel commands with Gaussian noise)")
     p.add_argument("--morphology", type=Path, help="champion JSON whose morphology to use (default: Khepera III)")
     p.add_argument("--env-steps", type=int, default=500_000, help="training budget in environment steps")
     p.add_argument("--timesteps", type=int, default=None,
@@ -166,14 +169,16 @@ def main(argv: list[str] | None = None) -> None:
     # 2. W worlds x N robots as one SB3 vector env; every robot is a sub-environment.
     world = {"environment": args.environment, "num_robots": args.robots, "max_cycles": args.steps,
              "reward": args.reward, "attach_reward": args.attach_reward, "reward_scope": args.reward_scope}
-    venv = VecMonitor(GatheringVecEnv(args.worlds, seed=args.seed, morphology=morphology, **world))
+    venv = VecMonitor(GatheringVecEnv(args.worlds, seed=args.seed, morphology=morphology,
+                                      wheel_levels=args.wheel_levels, **world))
     if args.norm_reward:
         venv = VecNormalize(venv, norm_obs=False, norm_reward=True, gamma=args.gamma)
 
     # 3. PPO with one shared policy; logs to stdout and CSV.
     model = PPO("MlpPolicy", venv, n_steps=args.n_steps, batch_size=min(2048, args.n_steps * venv.num_envs),
                 n_epochs=args.n_epochs, learning_rate=args.learning_rate, gamma=args.gamma, gae_lambda=0.95,
-                ent_coef=args.ent_coef, policy_kwargs={"log_std_init": args.log_std_init},
+                ent_coef=args.ent_coef,
+                policy_kwargs={} if args.wheel_levels else {"log_std_init": args.log_std_init},
                 seed=args.seed, verbose=1, device="cpu")
     model.set_logger(configure(str(args.out), ["stdout", "csv"]))
     log = EpisodeLog(args.out / "curve.csv", args.robots, args.max_minutes, args.snapshots, morphology)
@@ -196,7 +201,8 @@ def main(argv: list[str] | None = None) -> None:
                            {"environment": args.environment, "max_cycles": eval_steps, "num_robots": args.robots},
                            seeds)
     report = {"environment": args.environment, "reward": args.reward, "attach_reward": args.attach_reward,
-              "reward_scope": args.reward_scope, "worlds": args.worlds, "train_steps": args.steps,
+              "reward_scope": args.reward_scope, "wheel_levels": args.wheel_levels, "worlds": args.worlds,
+              "train_steps": args.steps,
               "env_steps": env_steps, "robot_steps": model.num_timesteps, "train_minutes": round(minutes, 2),
               "eval_steps": eval_steps, "eval_seeds": seeds, **row,
               "sampled": {"ft_mean": sampled["ft_mean"], "ft_std": sampled["ft_std"]}}

@@ -13,7 +13,10 @@ Sub-environment ``k`` is robot ``k % N`` of world ``k // N`` (W worlds of N robo
 ``num_envs = W * N``). Observation ``Box(0, 1, (S,), float32)`` (the morphology's
 readings), action ``Box(-1, 1, (2,), float32)`` (left, right wheel). Rewards are
 ``VectorSimulation.robot_rewards()`` (``reward`` / ``attach_reward`` / ``reward_scope``
-world options; see ``gathering_env.rewards``).
+world options; see ``gathering_env.rewards``). With ``wheel_levels=K`` the action space is
+``MultiDiscrete([K, K])`` instead: each wheel picks one of K commands evenly spaced in
+[-1, 1] (K = 3: back, stop, forward) — categorical policies keep a bounded exploration noise
+where a Gaussian's standard deviation can grow far beyond the action range (docs/rl).
 
 When a world's episode ends, its N sub-environments report ``done`` together, their infos
 carry ``terminal_observation``, ``TimeLimit.truncated`` and the episode's
@@ -42,6 +45,29 @@ from .vector import VectorSimulation
 SEED_LIMIT = 2**31
 """Episode seeds are drawn uniformly from [0, SEED_LIMIT)."""
 
+MAX_WHEEL_LEVELS = 101
+"""Upper bound on ``wheel_levels`` (commands per wheel of the discrete action space)."""
+
+
+def action_space(wheel_levels: int | None) -> spaces.Space:
+    """``Box(-1, 1, (2,))`` for ``None``, else ``MultiDiscrete([K, K])`` (see the module docstring)."""
+    if wheel_levels is None:
+        return spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
+    if (isinstance(wheel_levels, bool) or not isinstance(wheel_levels, numbers.Integral)
+            or not 2 <= wheel_levels <= MAX_WHEEL_LEVELS):
+        raise ValueError(f"wheel_levels={wheel_levels!r}; allowed: None (continuous wheel commands) or an "
+                         f"integer in [2, {MAX_WHEEL_LEVELS}]")
+    return spaces.MultiDiscrete([int(wheel_levels)] * 2)
+
+
+def wheel_commands(actions: np.ndarray, space: spaces.Space) -> np.ndarray:
+    """Wheel commands in [-1, 1] for actions of ``space``: a ``MultiDiscrete([K, K])`` action
+    picks among K evenly spaced commands; a ``Box`` action is the command itself (as float64)."""
+    actions = np.asarray(actions)
+    if isinstance(space, spaces.MultiDiscrete):
+        return np.linspace(-1.0, 1.0, int(space.nvec[0]))[actions.astype(np.int64)]
+    return actions.astype(np.float64)
+
 
 class GatheringVecEnv(VecEnv):
     """W worlds x N robots as ``W * N`` SB3 sub-environments (see the module docstring).
@@ -50,6 +76,8 @@ class GatheringVecEnv(VecEnv):
         num_worlds: W worlds stepped together (``VectorSimulation``).
         seed: seeds the generator of episode seeds (None: fresh entropy).
         morphology: every robot's sensor suite (default Khepera III).
+        wheel_levels: None (default) for continuous wheel commands, ``Box(-1, 1, (2,))``; or K
+            in [2, 101] for ``MultiDiscrete([K, K])``, K evenly spaced commands per wheel.
         **world_parameters: ``WorldConfig.from_kwargs`` arguments (``environment``,
             ``max_cycles``, ``num_robots``, ``reward``, ``reward_scope``, ...).
     """
@@ -57,13 +85,14 @@ class GatheringVecEnv(VecEnv):
     render_mode = None
 
     def __init__(self, num_worlds: int = 1, seed: int | None = None,
-                 morphology: Morphology | Sequence | dict | None = None, **world_parameters: Any) -> None:
+                 morphology: Morphology | Sequence | dict | None = None, wheel_levels: int | None = None,
+                 **world_parameters: Any) -> None:
+        actions = action_space(wheel_levels)
         self.sim = VectorSimulation(num_worlds, morphology=morphology, **world_parameters)
         self.config = self.sim.config
         self.num_worlds, self.num_robots = self.sim.num_worlds, self.config.num_robots
         observation_space = spaces.Box(0.0, 1.0, shape=(len(self.sim.morphology),), dtype=np.float32)
-        action_space = spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32)
-        super().__init__(self.num_worlds * self.num_robots, observation_space, action_space)
+        super().__init__(self.num_worlds * self.num_robots, observation_space, actions)
         self._seed = _check_seed(seed)
         self._rng = np.random.default_rng(self._seed)
         self._actions: np.ndarray | None = None
@@ -88,7 +117,7 @@ class GatheringVecEnv(VecEnv):
     def step_wait(self):
         if self._actions is None:
             raise RuntimeError("step_wait() without step_async(actions)")
-        wheels = self._actions.reshape(self.num_worlds, self.num_robots, 2)
+        wheels = wheel_commands(self._actions, self.action_space).reshape(self.num_worlds, self.num_robots, 2)
         self._actions = None
         obs, team, terminated, truncated = self.sim.step(wheels)
         rewards = self.sim.robot_rewards().reshape(-1).astype(np.float32)
@@ -144,4 +173,4 @@ def _check_seed(seed: Any) -> int | None:
     return None if seed is None else int(seed)
 
 
-__all__ = ["GatheringVecEnv"]
+__all__ = ["GatheringVecEnv", "action_space", "wheel_commands"]

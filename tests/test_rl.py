@@ -117,6 +117,44 @@ def test_vecenv_matches_vector_simulation_and_auto_resets():
         np.testing.assert_array_equal(obs[3 * w:3 * w + 3], reference.reset_world(w, int(draws[2 + w])))
 
 
+def test_discrete_wheel_levels_step_the_mapped_commands_and_train(tmp_path):
+    """wheel_levels=K: MultiDiscrete([K, K]) actions; index i of a wheel is command -1 + 2i/(K-1)
+    (hand values for K = 3 and 5), stepped exactly as VectorSimulation with those commands;
+    PPO trains on it and the saved model drives gathering-compare with mapped commands."""
+    from gymnasium import spaces
+
+    from evolution.compare import make_policy
+    from gathering_env.sb3 import GatheringVecEnv, action_space, wheel_commands
+    from gathering_env.vector import VectorSimulation
+
+    np.testing.assert_array_equal(wheel_commands(np.array([[0, 1], [2, 1]]), spaces.MultiDiscrete([3, 3])),
+                                  [[-1.0, 0.0], [1.0, 0.0]])
+    np.testing.assert_array_equal(wheel_commands(np.array([1, 3]), action_space(5)), [-0.5, 0.5])
+    np.testing.assert_array_equal(wheel_commands(np.array([0.25, -1.0], np.float32), action_space(None)), [0.25, -1.0])
+    options = dict(environment=1, num_robots=3, max_cycles=30)
+    venv = GatheringVecEnv(1, seed=5, wheel_levels=3, **options)
+    assert venv.action_space == spaces.MultiDiscrete([3, 3])
+    reference = VectorSimulation(1, **options)
+    reference.reset([int(np.random.default_rng(5).integers(0, 2**31))])
+    venv.reset()
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        actions = rng.integers(0, 3, (3, 2))
+        obs, *_ = venv.step(actions)
+        ref_obs, *_ = reference.step((actions - 1.0).reshape(1, 3, 2))
+        np.testing.assert_array_equal(obs, ref_obs.reshape(3, -1))
+    model = sb3.PPO("MlpPolicy", venv, n_steps=30, batch_size=45, n_epochs=1, seed=0, device="cpu")
+    model.learn(total_timesteps=180)
+    model.save(tmp_path / "model.zip")
+    policy = make_policy(f"ppo:{tmp_path / 'model.zip'}")
+    wheels = policy.act(np.full((4, 6), 0.5, np.float32))
+    assert wheels.shape == (4, 2) and set(np.unique(wheels)) <= {-1.0, 0.0, 1.0}
+    for bad in (1, 0, 102, 2.5, True, "3"):
+        with pytest.raises(ValueError, match=r"wheel_levels=.*; allowed: None \(continuous wheel commands\) or an "
+                                             r"integer in \[2, 101\]"):
+            GatheringVecEnv(1, wheel_levels=bad, **options)
+
+
 def test_vecenv_seed_makes_runs_reproducible():
     from gathering_env.sb3 import GatheringVecEnv
 
