@@ -61,6 +61,11 @@ def command(main: Callable[[list[str] | None], int]) -> Callable[[list[str] | No
                 return 130
             except ValueError as err:
                 return fail(str(err))
+            except BrokenPipeError:
+                # The reader went away (``gathering-evolve --list | head -1``): stop quietly, as
+                # Python's docs advise; point stdout at devnull so the exit flush cannot fail too.
+                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+                return 1
             except OSError as err:
                 return fail(describe_os_error(err))
             except MemoryError:

@@ -512,3 +512,14 @@ def test_deleted_front_of_a_multi_objective_run_is_rebuilt(tmp_path):
     shutil.rmtree(run / "front")
     assert evolve_main(["--resume", str(run), "--no-progress"]) == 0
     assert snapshot(run / "front") == front
+
+
+def test_a_closed_pipe_ends_the_cli_quietly():
+    """`gathering-evolve --list | head -1`: the reader closing the pipe is no file-system error
+    and no traceback; the command stops quietly with status 1 (Python's advice for EPIPE)."""
+    proc = subprocess.Popen([sys.executable, "-m", "evolution", "--list"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    proc.stdout.close()
+    err = proc.stderr.read().decode()
+    proc.stderr.close()
+    assert proc.wait(timeout=60) == 1 and err == ""
