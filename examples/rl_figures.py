@@ -49,10 +49,10 @@ chosen (docs/rl/README.md), so the final figures carry no selection effect."""
 
 
 def cache_key(spec: str, *parts: object) -> str:
-    """A policy's cache key: its spec plus, for a trained policy, a digest of the model file,
-    so a retrained model at the same path is evaluated again."""
+    """A policy's cache key: its spec plus, for a trained policy (PPO model, champion), a digest
+    of its file, so a retrained model at the same path is evaluated again."""
     kind, _, path = spec.partition(":")
-    digest = hashlib.sha1(Path(path).read_bytes()).hexdigest()[:10] if kind.startswith("ppo") else ""
+    digest = hashlib.sha1(Path(path).read_bytes()).hexdigest()[:10] if path else ""
     return "|".join([spec + (f"#{digest}" if digest else ""), *map(str, parts)])
 
 
