@@ -855,6 +855,20 @@ class Renderer:
 
 
 # ---------------------------------------------------------------------- figures
+def _check_frames(who: str, frames) -> list[np.ndarray]:
+    """The frames as arrays, all of one ``(H, W, 3)`` shape, or a ValueError naming ``who``."""
+    arrays = [np.asarray(f) for f in frames]
+    if not arrays:
+        raise ValueError(f"{who}: no frames; allowed: one or more frames")
+    shape = arrays[0].shape
+    if len(shape) != 3 or shape[2] != 3:
+        raise ValueError(f"{who}: frames must have shape (H, W, 3); frame 0 has {shape}")
+    for i, a in enumerate(arrays):
+        if a.shape != shape:
+            raise ValueError(f"{who}: frame {i} has shape {a.shape}; frame 0 has {shape}")
+    return arrays
+
+
 def film_strip(frames: Sequence[np.ndarray], captions: Sequence[str] | None = None,
                gap_px: int = 8) -> np.ndarray:
     """Frames side by side (``gap_px`` of page colour between them), a caption under each.
@@ -866,15 +880,8 @@ def film_strip(frames: Sequence[np.ndarray], captions: Sequence[str] | None = No
     Returns:
         ``(H + caption band, n * W + (n - 1) * gap_px, 3)`` uint8.
     """
-    frames = [np.asarray(f) for f in frames]
-    if not frames:
-        raise ValueError("film_strip: no frames; allowed: one or more frames")
+    frames = _check_frames("film_strip", frames)
     shape = frames[0].shape
-    if len(shape) != 3 or shape[2] != 3:
-        raise ValueError(f"film_strip: frames must have shape (H, W, 3); frame 0 has {shape}")
-    for i, f in enumerate(frames):
-        if f.shape != shape:
-            raise ValueError(f"film_strip: frame {i} has shape {f.shape}; frame 0 has {shape}")
     if captions is not None and len(captions) != len(frames):
         raise ValueError(f"film_strip: {len(captions)} captions for {len(frames)} frames; allowed: one per frame")
     if isinstance(gap_px, bool) or not isinstance(gap_px, (int, np.integer)) or gap_px < 0:
@@ -997,18 +1004,9 @@ def save_video(frames: Sequence[np.ndarray], path: str | os.PathLike, fps: int =
     suffix = path.suffix.lower()
     if suffix not in (".gif", ".mp4"):
         raise ValueError(f"video file {str(path)!r} has suffix {suffix!r}; allowed: '.gif', '.mp4'")
-    frames = list(frames)
-    if not frames:
-        raise ValueError("save_video: no frames to write")
     if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) or not fps > 0:
         raise ValueError(f"save_video: fps={fps!r}; allowed: a number > 0")
-    arrays = [np.asarray(f) for f in frames]
-    shape = arrays[0].shape
-    if len(shape) != 3 or shape[2] != 3:
-        raise ValueError(f"save_video: frames must have shape (H, W, 3); frame 0 has {shape}")
-    for i, a in enumerate(arrays):
-        if a.shape != shape:
-            raise ValueError(f"save_video: frame {i} has shape {a.shape}; frame 0 has {shape}")
+    arrays = _check_frames("save_video", frames)
     arrays = [a if a.dtype == np.uint8 else np.clip(a, 0, 255).astype(np.uint8) for a in arrays]
 
     import imageio.v2 as imageio
@@ -1025,7 +1023,7 @@ def save_video(frames: Sequence[np.ndarray], path: str | os.PathLike, fps: int =
     if suffix == ".gif":
         imageio.mimsave(path, arrays, duration=1000.0 / fps, loop=0)
     else:
-        h, w = shape[:2]
+        h, w = arrays[0].shape[:2]
         if h % 2 or w % 2:     # H.264 in yuv420p needs even sizes: pad by repeating the edge
             arrays = [np.pad(a, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge") for a in arrays]
         imageio.mimsave(path, arrays, fps=fps, macro_block_size=1)

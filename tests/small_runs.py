@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from evolution.cli import evolve_main
+from evolution.stats import read_stats, without_timing
 
 SMALL_WORLD = """
 [environment]          # a small world where a few blocks get gathered, so ft varies
@@ -18,6 +19,12 @@ block_counts = [8, 0, 0]
 max_cycles = 80
 num_robots = 10
 """
+
+def comparable_stats(run: Path) -> list[dict]:
+    """A run's statistics without what legitimately differs between equal runs (timings, the
+    count of retried evaluations), for comparing a resumed or healed run with an unbroken one."""
+    return without_timing([{k: v for k, v in r.items() if k != "failures"} for r in read_stats(run / "stats.jsonl")])
+
 
 _BUILT: dict[str, tuple[Path, Path, Path, Path]] = {}
 

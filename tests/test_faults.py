@@ -10,10 +10,11 @@ import time
 from pathlib import Path
 
 import pytest
+from small_runs import comparable_stats
 
 from evolution import backends
 from evolution.cli import evolve_main
-from evolution.stats import read_stats, without_timing
+from evolution.stats import read_stats
 
 ROOT = Path(__file__).resolve().parent.parent
 TINY = """
@@ -36,16 +37,12 @@ def experiment(tmp_path: Path, generations: int = 2) -> Path:
     return path
 
 
-def stats(run: Path):
-    return without_timing([{k: v for k, v in r.items() if k != "failures"} for r in read_stats(run / "stats.jsonl")])
-
-
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("ref")
     exp = experiment(tmp)
     assert evolve_main([str(exp), "--out", str(tmp / "run"), "--backend", "serial", "--no-progress"]) == 0
-    return exp, stats(tmp / "run")
+    return exp, comparable_stats(tmp / "run")
 
 
 def crash_once(marker: Path, how: str):
@@ -72,7 +69,7 @@ def test_failed_evaluations_are_retried(tmp_path, monkeypatch, reference, backen
     assert evolve_main([str(exp), "--out", str(tmp_path / "run"), "--backend", backend, "--workers", "2",
                         "--no-progress"]) == 0
     assert any((tmp_path / "marks").iterdir())      # faults really happened
-    assert stats(tmp_path / "run") == expected      # and were healed by retries
+    assert comparable_stats(tmp_path / "run") == expected      # and were healed by retries
     assert all(r["failures"] == 0 for r in read_stats(tmp_path / "run" / "stats.jsonl"))
 
 
@@ -138,7 +135,7 @@ def test_sigkill_mid_run_resumes_to_the_same_result(tmp_path):
     assert len(read_stats(tmp_path / "killed" / "stats.jsonl")) < 6
     assert evolve_main([str(exp), "--out", str(tmp_path / "killed"), "--resume", "--backend", "serial",
                         "--no-progress"]) == 0
-    assert stats(tmp_path / "killed") == stats(tmp_path / "full")
+    assert comparable_stats(tmp_path / "killed") == comparable_stats(tmp_path / "full")
 
 
 def test_sigint_finishes_the_generation_and_leaves_a_resumable_run(tmp_path):
@@ -155,7 +152,7 @@ def test_sigint_finishes_the_generation_and_leaves_a_resumable_run(tmp_path):
     newest = sorted((tmp_path / "stopped" / "checkpoints").glob("gen-*.ckpt"))[-1]
     assert newest.name == f"gen-{len(done):04d}.ckpt"          # statistics and checkpoint agree
     assert evolve_main([str(exp), "--out", str(tmp_path / "stopped"), "--resume", "--no-progress"]) == 0
-    assert stats(tmp_path / "stopped") == stats(tmp_path / "full")
+    assert comparable_stats(tmp_path / "stopped") == comparable_stats(tmp_path / "full")
 
 
 @pytest.mark.slow  # starting a local Ray takes ~15 s
@@ -164,10 +161,10 @@ def test_all_backends_agree(tmp_path, reference):
     exp, expected = reference
     assert evolve_main([str(exp), "--out", str(tmp_path / "process"), "--backend", "process", "--workers", "2",
                         "--no-progress"]) == 0
-    assert stats(tmp_path / "process") == expected
+    assert comparable_stats(tmp_path / "process") == expected
     assert evolve_main([str(exp), "--out", str(tmp_path / "ray"), "--backend", "ray", "--workers", "2",
                         "--no-progress"]) == 0
-    assert stats(tmp_path / "ray") == expected
+    assert comparable_stats(tmp_path / "ray") == expected
 
 
 def test_unknown_backend_and_missing_ray_message(tmp_path, monkeypatch, capsys, reference):

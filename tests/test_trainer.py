@@ -96,13 +96,22 @@ def test_existing_run_is_not_overwritten(serial_run, capsys):
     ("[environment]\nenvironment = 9\n", "environment=9"),
     ("[experiment\n", "not valid TOML"),
     ("[other]\nx = 1\n", "unknown section"),
+    ("", "experiment file is empty"),
+    ("# nothing but a comment\n", "experiment file is empty"),
+    ("experiment = 3\n", "allowed: a [experiment] table"),
+    ("[experiment]\ntrials = 100000\n", "trials=100000; allowed: an integer in [1, 1000]"),
+    ("[experiment]\nmethod = 'neat-m'\n[substrate]\nbottom_on_node0 = true\n", "[substrate] is used by method"),
 ])
 def test_broken_experiment_file_is_one_line_error(tmp_path, capsys, text, needle):
+    """Broken or unworkable experiment files: one line naming the file and the field, exit 2,
+    no run directory made."""
     path = tmp_path / "bad.toml"
     path.write_text(text)
     assert evolve_main([str(path), "--out", str(tmp_path / "run"), "--no-progress"]) == 2
     err = capsys.readouterr().err.strip()
-    assert needle in err and str(path) in err and len(err.splitlines()) == 1
+    assert err.startswith("error: ") and len(err.splitlines()) == 1 and "Traceback" not in err, err
+    assert needle in err and str(path) in err
+    assert not (tmp_path / "run").exists()
     assert not (tmp_path / "run").exists()
 
 
