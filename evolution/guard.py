@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import functools
+import math
 import os
 import re
 import sys
@@ -100,6 +101,24 @@ def int_arg(low: int, high: float) -> Callable[[str], int]:
         return value
 
     parse.__name__ = "integer"
+    return parse
+
+
+def float_arg(low: float, high: float = float("inf"), *, open_low: bool = False) -> Callable[[str], float]:
+    """argparse type: a finite number in [low, high] (``open_low``: in (low, high])."""
+
+    allowed = f"a number {'>' if open_low else '>='} {low}" + (f" and <= {high}" if high != float("inf") else "")
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number; allowed: {allowed}") from None
+        if not math.isfinite(value) or value < low or (open_low and value == low) or value > high:
+            raise argparse.ArgumentTypeError(f"{text} is out of range; allowed: {allowed}")
+        return value
+
+    parse.__name__ = "number"
     return parse
 
 

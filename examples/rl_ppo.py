@@ -31,6 +31,7 @@ import argparse
 import csv
 import json
 import os
+import sys
 import time
 from pathlib import Path
 
@@ -43,7 +44,9 @@ from stable_baselines3.common.callbacks import BaseCallback  # noqa: E402
 from stable_baselines3.common.logger import configure  # noqa: E402
 from stable_baselines3.common.vec_env import VecMonitor, VecNormalize  # noqa: E402
 
+from evolution.champion import load_champion  # noqa: E402
 from evolution.compare import compare, ppo_policy  # noqa: E402
+from evolution.guard import ArgumentParser, check_output_dir, command, float_arg, int_arg  # noqa: E402
 from gathering_env import Morphology  # noqa: E402
 from gathering_env.config import REWARD_SCOPES, REWARDS, WorldConfig  # noqa: E402
 from gathering_env.sb3 import GatheringVecEnv  # noqa: E402
@@ -121,12 +124,13 @@ def plot_curve(rows: list[dict], path: Path, title: str) -> None:
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = ArgumentParser(prog="rl_ppo.py", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    count = int_arg(1, float("inf"))
     p.add_argument("--environment", type=int, default=1, choices=(1, 2, 3))
-    p.add_argument("--steps", type=int, default=2000, help="episode length (max_cycles) while training")
-    p.add_argument("--eval-steps", type=int, default=None, help="episode length for the evaluation (default: --steps)")
-    p.add_argument("--robots", type=int, default=20)
-    p.add_argument("--worlds", type=int, default=4, help="worlds stepped together (sub-environments = worlds x robots)")
+    p.add_argument("--steps", type=count, default=2000, help="episode length (max_cycles) while training")
+    p.add_argument("--eval-steps", type=count, default=None, help="episode length for the evaluation (default: --steps)")
+    p.add_argument("--robots", type=count, default=20)
+    p.add_argument("--worlds", type=count, default=4, help="worlds stepped together (sub-environments = worlds x robots)")
     p.add_argument("--reward", choices=REWARDS, default="shaped")
     p.add_argument("--attach-reward", type=float, default=WorldConfig.attach_reward,
                    help=f"bonus per attachment with --reward shaped (default {WorldConfig.attach_reward})")
@@ -136,38 +140,44 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                    help="discrete actions: K evenly spaced commands per wheel (MultiDiscrete([K, K]); "
                         "default: continuous wheel commands with Gaussian noise)")
     p.add_argument("--morphology", type=Path, help="champion JSON whose morphology to use (default: Khepera III)")
-    p.add_argument("--env-steps", type=int, default=500_000, help="training budget in environment steps")
-    p.add_argument("--timesteps", type=int, default=None,
+    p.add_argument("--env-steps", type=count, default=500_000, help="training budget in environment steps")
+    p.add_argument("--timesteps", type=count, default=None,
                    help="training budget in robot-steps (SB3 timesteps) instead of --env-steps")
-    p.add_argument("--snapshots", type=int, nargs="*", default=[], metavar="ENV_STEPS",
+    p.add_argument("--snapshots", type=count, nargs="*", default=[], metavar="ENV_STEPS",
                    help="also save the policy as model-ENV_STEPS.zip when training passes these budgets "
                         "(e.g. an evolution run's budget, to compare at equal environment steps)")
-    p.add_argument("--max-minutes", type=float, default=None, help="stop training after this many minutes")
-    p.add_argument("--n-steps", type=int, default=256, help="PPO rollout length per sub-environment")
-    p.add_argument("--gamma", type=float, default=0.99)
-    p.add_argument("--ent-coef", type=float, default=0.01,
+    p.add_argument("--max-minutes", type=float_arg(0.0, open_low=True), default=None, help="stop training after this many minutes")
+    p.add_argument("--n-steps", type=int_arg(2, float("inf")), default=256, help="PPO rollout length per sub-environment")
+    p.add_argument("--gamma", type=float_arg(0.0, 1.0, open_low=True), default=0.99)
+    p.add_argument("--ent-coef", type=float_arg(0.0), default=0.01,
                    help="entropy bonus (default 0.01; with 0 training collapsed, see docs/rl/README.md)")
-    p.add_argument("--log-std-init", type=float, default=0.0,
+    p.add_argument("--log-std-init", type=float_arg(-20.0, 20.0), default=0.0,
                    help="initial log standard deviation of the Gaussian action noise (SB3 default 0)")
-    p.add_argument("--n-epochs", type=int, default=10, help="gradient epochs per rollout (default 10)")
-    p.add_argument("--learning-rate", type=float, default=1e-3, help="Adam step size (default 1e-3)")
+    p.add_argument("--n-epochs", type=int_arg(1, 1000), default=10, help="gradient epochs per rollout (default 10)")
+    p.add_argument("--learning-rate", type=float_arg(0.0, open_low=True), default=1e-3, help="Adam step size (default 1e-3)")
     p.add_argument("--norm-reward", action=argparse.BooleanOptionalAction, default=True,
                    help="scale rewards by a running estimate of the return's std (SB3 VecNormalize, rewards "
                         "only; default on)")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--eval-episodes", type=int, default=5)
+    p.add_argument("--seed", type=int_arg(0, 2**32 - 1), default=0)
+    p.add_argument("--eval-episodes", type=count, default=5)
     p.add_argument("--out", type=Path, default=Path("runs/ppo"))
     return p.parse_args(argv)
 
 
-def main(argv: list[str] | None = None) -> None:
+OUTPUTS = ("model.zip", "model.morphology.json", "progress.csv", "curve.csv", "curve.png", "evaluation.json")
+"""The files a run writes into --out (plus model-ENV_STEPS.zip / .morphology.json per snapshot)."""
+
+
+@command
+def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     torch.set_num_threads(1)
-    args.out.mkdir(parents=True, exist_ok=True)
+    snapshots = [f"model-{n}{suffix}" for n in args.snapshots for suffix in (".zip", ".morphology.json")]
+    check_output_dir(args.out, [*OUTPUTS, *snapshots])       # never overwrite anything but an earlier run's output
 
     # 1. The morphology: Khepera III or an evolved champion's sensors.
     if args.morphology:
-        morphology = Morphology.from_dict(json.loads(args.morphology.read_text())["morphology"])
+        morphology = load_champion(args.morphology).morphology
     else:
         morphology = Morphology.khepera_iii()
 
@@ -185,6 +195,7 @@ def main(argv: list[str] | None = None) -> None:
                 ent_coef=args.ent_coef,
                 policy_kwargs={} if args.wheel_levels else {"log_std_init": args.log_std_init},
                 seed=args.seed, verbose=1, device="cpu")
+    args.out.mkdir(parents=True, exist_ok=True)           # every input checked: only now touch the disk
     model.set_logger(configure(str(args.out), ["stdout", "csv"]))
     log = EpisodeLog(args.out / "curve.csv", args.robots, args.max_minutes, args.snapshots, morphology)
     start = time.perf_counter()
@@ -216,7 +227,8 @@ def main(argv: list[str] | None = None) -> None:
           f"ft over {len(seeds)} held-out episodes of {eval_steps} steps: {row['ft_mean']:.2f} +- {row['ft_std']:.2f} "
           f"(mean actions), {sampled['ft_mean']:.2f} +- {sampled['ft_std']:.2f} (sampled actions)")
     print(f"wrote {model_path}, {args.out / 'curve.png'}, {args.out / 'evaluation.json'}")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -31,6 +31,7 @@ package imports this module.
 
 from __future__ import annotations
 
+import functools
 import numbers
 from collections.abc import Sequence
 from typing import Any
@@ -65,8 +66,16 @@ def wheel_commands(actions: np.ndarray, space: spaces.Space) -> np.ndarray:
     picks among K evenly spaced commands; a ``Box`` action is the command itself (as float64)."""
     actions = np.asarray(actions)
     if isinstance(space, spaces.MultiDiscrete):
-        return np.linspace(-1.0, 1.0, int(space.nvec[0]))[actions.astype(np.int64)]
+        return _levels(int(space.nvec[0]))[actions.astype(np.int64)]
     return actions.astype(np.float64)
+
+
+@functools.cache
+def _levels(count: int) -> np.ndarray:
+    """The ``count`` wheel commands of the discrete action space (built once per count)."""
+    levels = np.linspace(-1.0, 1.0, count)
+    levels.flags.writeable = False
+    return levels
 
 
 class GatheringVecEnv(VecEnv):

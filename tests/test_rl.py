@@ -228,22 +228,27 @@ def test_ppo_sample_policy_is_seeded_and_differs_from_the_mean(tmp_path):
     assert rows[0]["ft_mean"] == rows[1]["ft_mean"]
 
 
-def test_rl_ppo_example_trains_saves_snapshots_and_evaluates(tmp_path):
-    """examples/rl_ppo.py end to end on a tiny budget: every output file, a snapshot at the asked
-    budget that gathering-compare loads (named after run and budget), the evaluation report."""
+def load_rl_ppo():
     import importlib.util
     from pathlib import Path
 
-    from evolution.compare import make_policy
-
     path = Path(__file__).resolve().parents[1] / "examples" / "rl_ppo.py"
     spec = importlib.util.spec_from_file_location("rl_ppo_example", path)
-    rl_ppo = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(rl_ppo)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_rl_ppo_example_trains_saves_snapshots_and_evaluates(tmp_path):
+    """examples/rl_ppo.py end to end on a tiny budget: every output file, a snapshot at the asked
+    budget that gathering-compare loads (named after run and budget), the evaluation report."""
+    from evolution.compare import make_policy
+
+    rl_ppo = load_rl_ppo()
     out = tmp_path / "run"
-    rl_ppo.main(["--environment", "1", "--robots", "3", "--worlds", "2", "--steps", "40", "--env-steps", "160",
+    assert rl_ppo.main(["--environment", "1", "--robots", "3", "--worlds", "2", "--steps", "40", "--env-steps", "160",
                  "--n-steps", "20", "--reward-scope", "local", "--norm-reward", "--log-std-init", "-0.5",
-                 "--snapshots", "40", "--eval-episodes", "2", "--out", str(out)])
+                 "--snapshots", "40", "--eval-episodes", "2", "--out", str(out)]) == 0
     for name in ("model.zip", "model.morphology.json", "model-40.zip", "model-40.morphology.json",
                  "curve.csv", "curve.png", "evaluation.json", "progress.csv"):
         assert (out / name).is_file(), name
@@ -253,3 +258,31 @@ def test_rl_ppo_example_trains_saves_snapshots_and_evaluates(tmp_path):
     snapshot = make_policy(f"ppo-sample:{out / 'model-40.zip'}")
     assert snapshot.name == "ppo-sample:run@40" and len(snapshot.morphology) == 6
     assert make_policy(f"ppo:{out / 'model.zip'}").name == "ppo:run"
+
+
+@pytest.mark.parametrize("argv,needle", [
+    (["--morphology", "{tmp}/nope.json"], "nope.json: champion file not found"),
+    (["--out", "{tmp}/full"], "folder is not empty (holds notes.txt)"),
+    (["--env-steps", "-5"], "--env-steps: -5 is out of range; allowed: an integer >= 1"),
+    (["--gamma", "nan"], "--gamma: nan is out of range; allowed: a number > 0.0 and <= 1.0"),
+    (["--learning-rate", "0"], "--learning-rate: 0 is out of range"),
+    (["--robots", "100000"], "num_robots=100000 out of range"),
+    (["--wheel-levels", "1"], "wheel_levels=1; allowed: None"),
+])
+def test_rl_ppo_example_refuses_bad_input_in_one_line(tmp_path, capsys, argv, needle):
+    """A wrong path, a folder with someone's files, a nonsense number: one line, exit 2, and
+    nothing written (no output folder made, the user's file untouched)."""
+    (tmp_path / "full").mkdir()
+    (tmp_path / "full" / "notes.txt").write_text("keep")
+    argv = [a.format(tmp=tmp_path) for a in argv]
+    if "--out" not in argv:
+        argv += ["--out", str(tmp_path / "new")]
+    try:
+        code = load_rl_ppo().main(["--env-steps", "10", *argv])
+    except SystemExit as stop:          # argparse's errors exit from the parser (status 2)
+        code = stop.code
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: ") and len(err.splitlines()) == 1 and needle in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["full"]
+    assert (tmp_path / "full" / "notes.txt").read_text() == "keep"
