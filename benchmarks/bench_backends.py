@@ -18,9 +18,9 @@ from pathlib import Path
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
-from evolution.experiment import load_experiment  # noqa: E402
-from evolution.stats import read_stats, without_timing  # noqa: E402
-from evolution.trainer import Trainer  # noqa: E402
+from evolution.run.experiment import load_experiment  # noqa: E402
+from evolution.run.stats import read_stats, without_timing  # noqa: E402
+from evolution.run.trainer import Trainer  # noqa: E402
 
 
 def main() -> None:

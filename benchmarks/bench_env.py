@@ -1,7 +1,7 @@
 """Environment throughput on the workload matched with the original Java simulator.
 
 Setting: environment 2, 20 robots, Khepera III morphology, pickup heuristic on, the
-"wander" team (``gathering_env.policies.WanderTeam``: forward at 0.8 with a drift in
+"wander" team (``evolution.policies.scripted.WanderTeam``: forward at 0.8 with a drift in
 +-0.3 redrawn every 50 steps, a 10-step spin after 20 consecutive steps with the front
 ultrasonic >= 0.999), 10 000-step trials, one process.
 
@@ -26,10 +26,10 @@ import time
 
 import numpy as np
 
+from evolution.policies.scripted import WanderTeam
 from gathering_env import Morphology, SensorSpec, parallel_env
-from gathering_env.kernels import CompiledSensorBank
-from gathering_env.policies import WanderTeam
-from gathering_env.sensing import SensorBank
+from gathering_env.compiled.kernels import CompiledSensorBank
+from gathering_env.reference.sensing import SensorBank
 from gathering_env.vector import VectorSimulation
 
 ENV = dict(environment=2, num_robots=20)

@@ -21,9 +21,9 @@ from pathlib import Path
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
-from evolution.experiment import load_experiment  # noqa: E402
-from evolution.stats import read_stats  # noqa: E402
-from evolution.trainer import Trainer  # noqa: E402
+from evolution.run.experiment import load_experiment  # noqa: E402
+from evolution.run.stats import read_stats  # noqa: E402
+from evolution.run.trainer import Trainer  # noqa: E402
 
 
 def run(workers: int, kernel: str, args: argparse.Namespace, root: Path) -> list[dict]:

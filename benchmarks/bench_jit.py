@@ -49,7 +49,8 @@ def timed(kernel: str, cache_dir: str) -> tuple[float, float, float]:
 def worker_stats(_: int) -> tuple[int, dict[str, tuple[int, int]]]:
     import numpy as np
 
-    from gathering_env import kernels, parallel_env
+    from gathering_env import parallel_env
+    from gathering_env.compiled import kernels
 
     env = parallel_env()
     env.reset(seed=0)

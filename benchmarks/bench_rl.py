@@ -7,7 +7,7 @@ Same PPO settings on each route (the ones of examples/rl_ppo.py), environment 1,
 
 * ``supersuit``: the unchanged PettingZoo env through ``pettingzoo_env_to_vec_env_v1`` and
   ``concat_vec_envs_v1`` (one world, one process), as examples/rl_ppo.py did before.
-* ``vecenv W=...``: ``gathering_env.sb3.GatheringVecEnv`` with W worlds stepped together.
+* ``vecenv W=...``: ``gathering_env.rl.sb3.GatheringVecEnv`` with W worlds stepped together.
 
 Prints, per route, robot-steps per second of the whole ``learn`` call (rollout collection +
 gradient updates) and of the rollout collection alone (SB3's ``time/fps`` excludes
@@ -42,7 +42,7 @@ def supersuit_env(robots: int, steps: int):
 
 
 def vec_env(worlds: int, robots: int, steps: int):
-    from gathering_env.sb3 import GatheringVecEnv
+    from gathering_env.rl.sb3 import GatheringVecEnv
 
     return GatheringVecEnv(worlds, seed=0, environment=1, num_robots=robots, max_cycles=steps)
 

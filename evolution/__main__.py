@@ -1,5 +1,5 @@
 """``python -m evolution`` = ``gathering-evolve``."""
 
-from .cli import run_evolve
+from evolution.cli import run_evolve
 
 run_evolve()

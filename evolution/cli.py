@@ -11,7 +11,8 @@ import os
 import sys
 from pathlib import Path
 
-from .experiment import (
+from evolution.guard import ArgumentParser, UsageError, check_output_file, command, int_arg
+from evolution.run.experiment import (
     LIMITS,
     METHODS,
     is_preset_name,
@@ -21,7 +22,6 @@ from .experiment import (
     preset_names,
     preset_path,
 )
-from .guard import ArgumentParser, UsageError, check_output_file, command, int_arg
 
 MAX_WORKERS = max(4, 4 * (os.cpu_count() or 1))
 """Most evaluation processes ``--workers`` may ask for: four per core (each worker holds its own
@@ -111,7 +111,7 @@ def evolve_main(argv: list[str] | None = None) -> int:
         raise UsageError(f"--resume-from {args.resume_from}: is a folder; allowed: a checkpoint file "
                          "(RUN_DIR/checkpoints/gen-NNNN.ckpt), or --resume RUN_DIR")
     if out is None and args.resume_from is not None:
-        from .trainer import run_dir_of
+        from evolution.run.trainer import run_dir_of
 
         out = run_dir_of(args.resume_from)
         if out is None:
@@ -124,7 +124,7 @@ def evolve_main(argv: list[str] | None = None) -> int:
     else:
         experiment = load_experiment(args.experiment, overrides)
         out = out or Path("runs") / f"{experiment.name}-seed{experiment.seed}"
-    from .trainer import Trainer
+    from evolution.run.trainer import Trainer
 
     trainer = Trainer(experiment, out, workers=args.workers, resume=resume,
                       resume_from=args.resume_from, progress=not args.no_progress,
@@ -180,10 +180,9 @@ def replay_main(argv: list[str] | None = None) -> int:
     look.add_argument("--sensors-png", type=Path, help="also save the team's sensor layout (like the paper's Figure 3)")
     args = parser.parse_args(argv)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    from evolution.replay import replay
+    from evolution.run.champion import load_champion
     from gathering_env.render import RenderOptionError
-
-    from .champion import load_champion
-    from .replay import replay
 
     render_options = {name: value for name, value in (
         ("cones", args.cones), ("view", args.view), ("size_px", args.size), ("trail", args.trail),
@@ -226,8 +225,8 @@ def analyze_main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("runs", nargs="+", type=Path, help="run directories written by gathering-evolve")
     parser.add_argument("--out", type=Path, default=Path("report"), help="output directory (default: report/)")
-    from .backends import BACKENDS
-    from .reevaluate import REEVALUATE_TRIALS
+    from evolution.analysis.reevaluate import REEVALUATE_TRIALS
+    from evolution.run.backends import BACKENDS
 
     parser.add_argument("--reevaluate", type=int_arg(0, 100_000), default=REEVALUATE_TRIALS, metavar="K",
                         help="re-run every SO champion and MO front genome K times on held-out seeds and report "
@@ -238,9 +237,9 @@ def analyze_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--backend", choices=BACKENDS, default="process",
                         help="where --reevaluate runs (default: process pool)")
     args = parser.parse_args(argv)
-    from .analysis import analyse
-    from .guard import check_output_dir
-    from .report import REPORT_FILES, write_report
+    from evolution.analysis.fronts import analyse
+    from evolution.analysis.report import REPORT_FILES, write_report
+    from evolution.guard import check_output_dir
 
     check_output_dir(args.out, REPORT_FILES)
     analysis = analyse(args.runs, reevaluate=args.reevaluate, workers=args.workers, backend=args.backend)

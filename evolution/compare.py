@@ -5,22 +5,7 @@
 the same environment and episode seeds and writes ``compare.md`` / ``compare.csv`` (mean +- std
 ft, blocks gathered by type, time to finish) and ``compare.png`` (a bar plot).
 
-Policies (each carries the morphology it was made for):
-
-* ``random``: uniform random wheel commands (Khepera III morphology).
-* ``heuristic``: the pickup heuristic with a fixed search pattern on Khepera III readings:
-  drive forward on a slight curve, turn on the spot while the front ultrasonic or either
-  infrared sensor reports an obstacle close ahead.
-* ``wander``: the speed benchmark's explorer (``gathering_env.policies.WanderTeam``): forward
-  at 0.8 of top speed with a drift redrawn every 50 steps, spin on the spot when the front
-  ultrasonic has read an obstacle very close for 20 steps (Khepera III morphology).
-* ``champion:PATH``: an evolved team from a champion JSON (its own morphology).
-* ``ppo:PATH``: a Stable-Baselines3 PPO model (``examples/rl_ppo.py``) with the morphology
-  saved next to it (``PATH`` with suffix ``.morphology.json``), Khepera III if absent; its
-  deterministic actions (the policy's mean; with discrete wheel commands, ``wheel_levels``,
-  each wheel's most likely command).
-* ``ppo-sample:PATH``: the same model with actions sampled from its distribution, as in
-  training (torch's generator seeded by the episode seed).
+Policies: ``evolution.policies`` (the names ``--policy`` takes are listed there).
 """
 
 from __future__ import annotations
@@ -28,130 +13,15 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from gathering_env import Morphology, WorldConfig, parallel_env
-from gathering_env.policies import WanderTeam
-
-from .experiment import LIMITS
-from .guard import ArgumentParser, check_output_dir, command, int_arg
-
-
-@dataclass
-class Policy:
-    """A named team policy: ``act(obs (N, S)) -> wheels (N, 2)`` for its morphology."""
-
-    name: str
-    morphology: Morphology
-    act: Any
-    reset: Any = field(default=lambda seed: None)
-
-
-def random_policy() -> Policy:
-    state = {"rng": np.random.default_rng(0)}
-
-    def act(obs):
-        return state["rng"].uniform(-1.0, 1.0, (obs.shape[0], 2))
-
-    def reset(seed):
-        state["rng"] = np.random.default_rng(seed)
-
-    return Policy("random", Morphology.khepera_iii(), act, reset)
-
-
-def heuristic_policy() -> Policy:
-    """Search pattern on Khepera III readings (bottom, IR +40, IR -40, US 0, US +90, US -90)."""
-
-    def act(obs):
-        wheels = np.tile([1.0, 0.85], (obs.shape[0], 1))
-        blocked = (obs[:, 3] > 0.75) | (obs[:, 1] > 0.0) | (obs[:, 2] > 0.0)
-        wheels[blocked] = [1.0, -1.0]
-        return wheels
-
-    return Policy("heuristic", Morphology.khepera_iii(), act)
-
-
-def wander_policy() -> Policy:
-    """The benchmark's explorer (``gathering_env.policies.WanderTeam``) on Khepera III."""
-    team = WanderTeam(Morphology.khepera_iii())
-    return Policy("wander", team.morphology, team.act, team.reset)
-
-
-def champion_policy(path: str) -> Policy:
-    from .champion import load_champion
-
-    champion = load_champion(path)
-    return Policy(f"champion:{Path(path).parent.name or path}", champion.morphology, champion.controller.act)
-
-
-def ppo_policy(path: str, sample: bool = False) -> Policy:
-    """A saved SB3 model (continuous or discrete wheel commands, as its action space says);
-    deterministic actions (the policy's mean / most likely command), or with ``sample`` actions
-    drawn from the policy's distribution (torch's generator seeded by the episode seed)."""
-    try:
-        from stable_baselines3 import PPO
-    except ImportError:
-        raise ValueError("ppo policies need Stable-Baselines3: pip install 'gathering-evolution[rl]'") from None
-    from .champion import read_json
-
-    model_path = Path(path)
-    if not model_path.is_file():
-        raise ValueError(f"{model_path}: PPO model not found; allowed: a model .zip saved by Stable-Baselines3")
-    morph_path = model_path.with_suffix(".morphology.json")
-    morphology = Morphology.khepera_iii()
-    if morph_path.exists():
-        try:
-            morphology = Morphology.coerce(read_json(morph_path, "morphology file"))
-        except ValueError as err:
-            raise ValueError(f"{morph_path}: {err}") from None
-    try:
-        model = PPO.load(str(model_path), device="cpu")
-    except Exception as err:  # noqa: BLE001 - SB3/zipfile/torch raise many types for a broken file
-        raise ValueError(f"{model_path}: not a readable Stable-Baselines3 PPO model ({type(err).__name__}: "
-                         f"{err}); allowed: a model .zip saved by PPO.save") from None
-    expected = model.observation_space.shape
-    if expected != (len(morphology),):
-        raise ValueError(f"{model_path}: the policy expects observations of shape {expected}, but its morphology "
-                         f"has {len(morphology)} sensors; save the morphology as {morph_path.name}")
-
-    from gathering_env.sb3 import wheel_commands
-
-    def act(obs):
-        action, _ = model.predict(obs.astype(np.float32), deterministic=not sample)
-        return wheel_commands(action, model.action_space).reshape(obs.shape[0], 2)
-
-    def reset(seed):
-        if sample:
-            import torch
-
-            torch.manual_seed(seed)
-
-    # SB3 saves "model.zip" by default: name such a model after its run directory instead, and
-    # a snapshot of rl_ppo.py (model-ENV_STEPS.zip) after its run and budget.
-    label = model_path.stem
-    if model_path.parent.name and (label == "model" or label.startswith("model-")):
-        label = model_path.parent.name + label[len("model"):].replace("-", "@", 1)
-    return Policy(f"{'ppo-sample' if sample else 'ppo'}:{label}", morphology, act, reset)
-
-
-def make_policy(spec: str) -> Policy:
-    kind, _, arg = spec.partition(":")
-    if kind == "random" and not arg:
-        return random_policy()
-    if kind == "heuristic" and not arg:
-        return heuristic_policy()
-    if kind == "wander" and not arg:
-        return wander_policy()
-    if kind == "champion" and arg:
-        return champion_policy(arg)
-    if kind in ("ppo", "ppo-sample") and arg:
-        return ppo_policy(arg, sample=kind == "ppo-sample")
-    raise ValueError(f"--policy {spec}: unknown policy; allowed: random, heuristic, wander, champion:PATH, "
-                     "ppo:PATH, ppo-sample:PATH")
+from evolution.guard import ArgumentParser, check_output_dir, command, int_arg
+from evolution.policies import Policy, make_policy
+from evolution.run.experiment import LIMITS
+from gathering_env import WorldConfig, parallel_env
 
 
 def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:

@@ -8,10 +8,9 @@ from typing import Any
 
 import numpy as np
 
+from evolution.run.champion import Champion
 from gathering_env import parallel_env
 from gathering_env.render import RenderOptionError, film_strip, save_png, save_video, sensor_layout
-
-from .champion import Champion
 
 
 def parse_steps(value: str | Sequence[int], max_cycles: int) -> list[int]:

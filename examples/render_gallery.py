@@ -19,7 +19,7 @@ import numpy as np
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
-from evolution.champion import ChampionError, load_champion  # noqa: E402
+from evolution.run.champion import ChampionError, load_champion  # noqa: E402
 from gathering_env import Morphology, SensorSpec, parallel_env  # noqa: E402
 from gathering_env.render import Renderer, film_strip, save_png, sensor_layout  # noqa: E402
 

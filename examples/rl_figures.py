@@ -37,7 +37,8 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
 import numpy as np  # noqa: E402
 
-from evolution.compare import compare, make_policy, run_episode, write_outputs  # noqa: E402
+from evolution.compare import compare, run_episode, write_outputs
+from evolution.policies import make_policy  # noqa: E402
 from gathering_env import parallel_env  # noqa: E402
 
 SEEDS = list(range(10_000, 10_005))

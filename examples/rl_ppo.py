@@ -1,6 +1,6 @@
 """Shared-parameter PPO for the whole team (Stable-Baselines3) on the many-worlds vector env.
 
-Every robot of every world is one sub-environment of ``gathering_env.sb3.GatheringVecEnv``,
+Every robot of every world is one sub-environment of ``gathering_env.rl.sb3.GatheringVecEnv``,
 so one PPO policy is trained on all robots' experience at once and drives every robot at
 test time. The reward is shaped by default (``--reward shaped``: potential-based shaping
 towards the zone plus an attachment term) with local credit (``--reward-scope local``: each
@@ -44,12 +44,13 @@ from stable_baselines3.common.callbacks import BaseCallback  # noqa: E402
 from stable_baselines3.common.logger import configure  # noqa: E402
 from stable_baselines3.common.vec_env import VecMonitor, VecNormalize  # noqa: E402
 
-from evolution.champion import load_champion  # noqa: E402
-from evolution.compare import compare, ppo_policy  # noqa: E402
+from evolution.compare import compare
 from evolution.guard import ArgumentParser, check_output_dir, command, float_arg, int_arg  # noqa: E402
+from evolution.policies.learned import ppo_policy  # noqa: E402
+from evolution.run.champion import load_champion  # noqa: E402
 from gathering_env import Morphology  # noqa: E402
 from gathering_env.config import REWARD_SCOPES, REWARDS, WorldConfig  # noqa: E402
-from gathering_env.sb3 import GatheringVecEnv  # noqa: E402
+from gathering_env.rl.sb3 import GatheringVecEnv  # noqa: E402
 
 EVAL_SEED = 10_000
 """First held-out evaluation seed (training episode seeds come from the --seed generator)."""

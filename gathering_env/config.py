@@ -134,7 +134,7 @@ class WorldConfig:
     # --- implementation ----------------------------------------------------------------
     kernel: str = "compiled"
     """Which implementation computes everything of a step but pymunk's physics: 'compiled'
-    (numba kernels, ``gathering_env.kernels``) or 'numpy' (the vectorised reference).
+    (numba kernels, ``gathering_env.compiled.kernels``) or 'numpy' (the vectorised reference).
     Both give the same episodes; see docs/performance.md."""
 
     environment: int | None = field(default=2, compare=False)

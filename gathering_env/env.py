@@ -16,7 +16,7 @@ action and drives towards the zone.
 
 ## Observation space
 ``Box(0, 1, (S,), float32)`` per robot, one entry per sensor of the current morphology,
-in morphology order (see ``gathering_env.sensing`` for each type's reading). With the
+in morphology order (see ``gathering_env.reference.sensing`` for each type's reading). With the
 default Khepera III morphology S = 6: bottom, IR +40 deg, IR -40 deg, ultrasonic 0 deg,
 ultrasonic +90 deg, ultrasonic -90 deg.
 
@@ -55,7 +55,7 @@ keyword. ``reset(seed=..., options={"morphology": Morphology | list of sensor di
 kernels; ``kernel="numpy"`` uses the vectorised numpy reference. Both give the same
 episodes (tested bit for bit); the compiled one is several times faster (docs/performance.md).
 The first use of the compiled kernel in a fresh environment compiles it (a few seconds, once;
-the machine code is cached on disk, see ``gathering_env.kernels``).
+the machine code is cached on disk, see ``gathering_env.compiled.kernels``).
 
 ## Many worlds
 ``gathering_env.vector.VectorSimulation(num_worlds, **world_parameters)`` steps W

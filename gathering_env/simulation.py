@@ -14,7 +14,7 @@ observation) -> heuristics override them (collision avoidance, attached robots) 
 Two kernels compute the same step, chosen by ``WorldConfig.kernel``:
 
 * ``"compiled"`` (default): ``CompiledSimulation``, numba kernels around pymunk
-  (``gathering_env.engine``; one world of the batched engine).
+  (``gathering_env.compiled.engine``; one world of the batched engine).
 * ``"numpy"``: ``NumpySimulation``, the vectorised numpy reference (``sensing``,
   ``heuristics``, ``scoring``) that the tests compare the compiled kernels against.
 
@@ -25,12 +25,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from .compiled.engine import CompiledWorlds
 from .config import WorldConfig
-from .engine import CompiledWorlds
-from .heuristics import attached_wheels, avoidance_turns, pickup_candidates
+from .reference.heuristics import attached_wheels, avoidance_turns, pickup_candidates
+from .reference.sensing import SensorBank
 from .rewards import RewardShaper
 from .scoring import gathered_mask, task_performance
-from .sensing import SensorBank
 from .sensors import Morphology
 from .world import GatheringWorld
 

@@ -40,8 +40,8 @@ from typing import Any
 
 import numpy as np
 
+from .compiled.engine import CompiledWorlds
 from .config import WorldConfig
-from .engine import CompiledWorlds
 from .scoring import task_performance
 from .sensors import Morphology
 from .simulation import GatheringSimulation, NumpySimulation

@@ -15,7 +15,7 @@ no side-slip, brakes when its wheels stop, and can push with at most its drive f
 State is exchanged with pymunk in bulk through ``pymunk.batch`` (one call to read every
 body's pose and velocity, one to set all velocities); the rest of the package works on the
 numpy arrays ``robot_pos``, ``robot_angle``, ``block_pos`` and ``block_angle``. These arrays
-are updated in place, so a batch of worlds (``gathering_env.engine``) can own them as views
+are updated in place, so a batch of worlds (``gathering_env.compiled.engine``) can own them as views
 of its own (W, ...) arrays (``adopt``).
 """
 

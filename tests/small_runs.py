@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from evolution.cli import evolve_main
-from evolution.stats import read_stats, without_timing
+from evolution.run.stats import read_stats, without_timing
 
 SMALL_WORLD = """
 [environment]          # a small world where a few blocks get gathered, so ft varies

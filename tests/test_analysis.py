@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from evolution.analysis import analyse, merge_fronts, selection_points
+from evolution.analysis.fronts import analyse, merge_fronts, selection_points
+from evolution.analysis.report import write_report
 from evolution.cli import analyze_main
-from evolution.report import write_report
 
 
 def make_run(root: Path, name: str, env: int, multi: bool, champion: tuple[float, float],

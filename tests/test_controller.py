@@ -10,9 +10,9 @@ import neat
 import numpy as np
 import pytest
 
-from evolution.breeding import NEATReproduction
-from evolution.controller import TeamController
-from evolution.direct import NEATMGenome, decode_neat_m
+from evolution.encodings.controller import TeamController
+from evolution.encodings.direct import NEATMGenome, decode_neat_m
+from evolution.reproduction.breeding import NEATReproduction
 
 CFG = Path(__file__).resolve().parent.parent / "configs" / "neat_m.neat.cfg"
 

@@ -128,7 +128,7 @@ def _run_page(page: Path, marks: set[str | None], workdir: Path, bin_dir: Path) 
         elif block.lang in SHELL:
             cmd = ["bash", "-e", "-o", "pipefail", "-c", _shell_code(block)]
         elif block.lang == "toml" and "[experiment]" in block.code:
-            from evolution.experiment import load_experiment
+            from evolution.run.experiment import load_experiment
 
             experiment_file = workdir / f"block{n}.toml"
             experiment_file.write_text(block.code, encoding="utf-8")

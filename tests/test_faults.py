@@ -12,9 +12,9 @@ from pathlib import Path
 import pytest
 from small_runs import comparable_stats
 
-from evolution import backends
 from evolution.cli import evolve_main
-from evolution.stats import read_stats
+from evolution.run import backends
+from evolution.run.stats import read_stats
 
 ROOT = Path(__file__).resolve().parent.parent
 TINY = """

@@ -14,11 +14,11 @@ import neat
 import numpy as np
 import pytest
 
-from evolution.breeding import BreedingGenome, NEATReproduction, breed, truncate
-from evolution.direct import NEATMGenome, SensorGene, decode_neat_m
-from evolution.genome import CPPNGenome
-from evolution.mods import MODSReproduction
-from evolution.substrate import Substrate, decode
+from evolution.encodings.direct import NEATMGenome, SensorGene, decode_neat_m
+from evolution.encodings.genome import CPPNGenome
+from evolution.encodings.substrate import Substrate, decode
+from evolution.reproduction.breeding import BreedingGenome, NEATReproduction, breed, truncate
+from evolution.reproduction.mods import MODSReproduction
 from gathering_env import SENSOR_TYPES
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"

@@ -33,9 +33,9 @@ import pytest
 from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
 
+from evolution.analysis.reevaluate import CACHE_FILE as REEVALUATION_CACHE
 from evolution.cli import analyze_main, evolve_main, replay_main
 from evolution.compare import compare_main
-from evolution.reevaluate import CACHE_FILE as REEVALUATION_CACHE
 
 ROOT = Path(__file__).resolve().parent.parent
 TINY = """[experiment]

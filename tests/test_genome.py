@@ -9,10 +9,10 @@ from pathlib import Path
 import neat
 import pytest
 
-from evolution.breeding import NEATReproduction
-from evolution.direct import NEATMGenome, SensorGene, decode_neat_m
-from evolution.genome import CPPNGenome
-from evolution.substrate import decode
+from evolution.encodings.direct import NEATMGenome, SensorGene, decode_neat_m
+from evolution.encodings.genome import CPPNGenome
+from evolution.encodings.substrate import decode
+from evolution.reproduction.breeding import NEATReproduction
 from gathering_env import SENSOR_TYPES, Morphology
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"

@@ -20,10 +20,10 @@ import numpy as np
 import pytest
 from small_runs import comparable_stats
 
-from evolution import backends
 from evolution.cli import analyze_main, evolve_main, replay_main
 from evolution.compare import compare_main
-from evolution.stats import read_stats
+from evolution.run import backends
+from evolution.run.stats import read_stats
 from gathering_env import parallel_env
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -230,7 +230,7 @@ def test_unusable_paths_and_options_are_one_line_errors(finished, tmp_path, caps
 
 
 def test_unwritable_run_directory_mid_run_is_one_line_and_resumable(tmp_path, capsys, monkeypatch):
-    from evolution import trainer as trainer_module
+    from evolution.run import trainer as trainer_module
 
     exp = write_tiny(tmp_path, generations=2)
     real = trainer_module.append_stats

@@ -54,7 +54,7 @@ def test_wheel_in_a_fresh_virtualenv(tmp_path):
     env = {"PATH": f"{venv / 'bin'}:/usr/bin:/bin", "HOME": str(tmp_path),
            "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy"}
 
-    where = subprocess.run([str(vpy), "-c", "import gathering_env, evolution.experiment as e; "
+    where = subprocess.run([str(vpy), "-c", "import gathering_env, evolution.run.experiment as e; "
                             "print(gathering_env.__file__); print(e.CONFIG_DIR); print(gathering_env.__version__)"],
                            cwd=elsewhere, env=env, capture_output=True, text=True)
     assert where.returncode == 0, where.stderr

@@ -17,11 +17,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from evolution.policies.scripted import WanderTeam
 from gathering_env import parallel_env
+from gathering_env.compiled.kernels import CompiledSensorBank
 from gathering_env.config import WorldConfig
-from gathering_env.kernels import CompiledSensorBank
-from gathering_env.policies import WanderTeam
-from gathering_env.sensing import SensorBank
+from gathering_env.reference.sensing import SensorBank
 from gathering_env.sensors import SENSOR_TYPES, Morphology, SensorSpec
 from gathering_env.simulation import CompiledSimulation, GatheringSimulation, NumpySimulation
 from gathering_env.vector import VectorSimulation

@@ -11,9 +11,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from evolution.breeding import BreedingGenome
-from evolution.mods import MODSReproduction
-from evolution.pareto import non_dominated_fronts
+from evolution.reproduction.breeding import BreedingGenome
+from evolution.reproduction.mods import MODSReproduction
+from evolution.reproduction.pareto import non_dominated_fronts
 
 NEAT_CFG = """
 [NEAT]

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from evolution.pareto import crowding_distance, non_dominated_fronts, nsga2_order
+from evolution.reproduction.pareto import crowding_distance, non_dominated_fronts, nsga2_order
 
 
 def brute_force_fronts(F: np.ndarray) -> list[set[int]]:

@@ -14,7 +14,7 @@ import pytest
 import gathering_env
 from evolution import __version__ as evolution_version
 from evolution.cli import evolve_main
-from evolution.experiment import (
+from evolution.run.experiment import (
     CONFIG_DIR,
     ExperimentError,
     is_preset_name,

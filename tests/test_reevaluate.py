@@ -9,12 +9,18 @@ import numpy as np
 import pytest
 import small_runs
 
-from evolution.analysis import analyse
-from evolution.champion import genome_from_dict, load_champion
+from evolution.analysis.fronts import analyse
+from evolution.analysis.reevaluate import (
+    CACHE_FILE,
+    _run_setup,
+    heldout_seeds,
+    reevaluate_run,
+    training_seeds,
+)
 from evolution.cli import analyze_main
-from evolution.evaluate import evaluate, trial_seed
-from evolution.pareto import non_dominated_fronts
-from evolution.reevaluate import CACHE_FILE, _run_setup, heldout_seeds, reevaluate_run, training_seeds
+from evolution.reproduction.pareto import non_dominated_fronts
+from evolution.run.champion import genome_from_dict, load_champion
+from evolution.run.evaluate import evaluate, trial_seed
 
 
 @pytest.fixture(scope="module")

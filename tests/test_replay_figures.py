@@ -9,9 +9,9 @@ import imageio.v2 as imageio
 import numpy as np
 import pytest
 
-from evolution.champion import FORMAT, VERSION
 from evolution.cli import replay_main
-from evolution.controller import TeamController
+from evolution.encodings.controller import TeamController
+from evolution.run.champion import FORMAT, VERSION
 from gathering_env import Morphology, SensorSpec
 from gathering_env.render import PAGE, WALL, cone_colour_on
 

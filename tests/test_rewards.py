@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from evolution.policies.scripted import WanderTeam
 from gathering_env import parallel_env
 from gathering_env.config import WorldConfig
-from gathering_env.policies import WanderTeam
 from gathering_env.simulation import GatheringSimulation
 from gathering_env.vector import VectorSimulation
 

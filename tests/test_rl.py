@@ -84,7 +84,7 @@ def test_unknown_policy_spec(capsys):
 # ---------------------------------------------------------------------- GatheringVecEnv
 def test_vecenv_matches_vector_simulation_and_auto_resets():
     """Sub-env k = robot k % N of world k // N; ends, infos and auto-reset as documented."""
-    from gathering_env.sb3 import SEED_LIMIT, GatheringVecEnv
+    from gathering_env.rl.sb3 import SEED_LIMIT, GatheringVecEnv
     from gathering_env.vector import VectorSimulation
 
     options = dict(environment=1, num_robots=3, max_cycles=25, reward="shaped", reward_scope="local")
@@ -123,8 +123,8 @@ def test_discrete_wheel_levels_step_the_mapped_commands_and_train(tmp_path):
     PPO trains on it and the saved model drives gathering-compare with mapped commands."""
     from gymnasium import spaces
 
-    from evolution.compare import make_policy
-    from gathering_env.sb3 import GatheringVecEnv, action_space, wheel_commands
+    from evolution.policies import make_policy
+    from gathering_env.rl.sb3 import GatheringVecEnv, action_space, wheel_commands
     from gathering_env.vector import VectorSimulation
 
     np.testing.assert_array_equal(wheel_commands(np.array([[0, 1], [2, 1]]), spaces.MultiDiscrete([3, 3])),
@@ -156,7 +156,7 @@ def test_discrete_wheel_levels_step_the_mapped_commands_and_train(tmp_path):
 
 
 def test_vecenv_seed_makes_runs_reproducible():
-    from gathering_env.sb3 import GatheringVecEnv
+    from gathering_env.rl.sb3 import GatheringVecEnv
 
     def trace(venv):
         rng, out = np.random.default_rng(1), [venv.reset()]
@@ -182,7 +182,7 @@ def test_vecenv_passes_sb3_checks_and_trains_ppo(tmp_path):
     from stable_baselines3.common.env_checker import check_env as sb3_check_env
     from stable_baselines3.common.vec_env import VecCheckNan, VecMonitor, VecNormalize
 
-    from gathering_env.sb3 import GatheringVecEnv
+    from gathering_env.rl.sb3 import GatheringVecEnv
 
     single = gymnasium.make(TEAM_ENV_ID, environment=1, num_robots=1, max_cycles=30, reward="shaped")
     sb3_check_env(single.unwrapped)
@@ -209,7 +209,8 @@ def test_compare_wander_runs(tmp_path, capsys):
 
 
 def test_ppo_sample_policy_is_seeded_and_differs_from_the_mean(tmp_path):
-    from evolution.compare import compare, make_policy
+    from evolution.compare import compare
+    from evolution.policies import make_policy
 
     env = parallel_env(environment=1, num_robots=3, max_cycles=20)
     env.reset(seed=0)
@@ -242,7 +243,7 @@ def load_rl_ppo():
 def test_rl_ppo_example_trains_saves_snapshots_and_evaluates(tmp_path):
     """examples/rl_ppo.py end to end on a tiny budget: every output file, a snapshot at the asked
     budget that gathering-compare loads (named after run and budget), the evaluation report."""
-    from evolution.compare import make_policy
+    from evolution.policies import make_policy
 
     rl_ppo = load_rl_ppo()
     out = tmp_path / "run"

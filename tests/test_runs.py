@@ -13,12 +13,12 @@ import pytest
 import small_runs
 from small_runs import evolve, experiment_file
 
-from evolution import trainer as trainer_module
-from evolution.champion import genome_from_dict, load_champion
-from evolution.evaluate import Evaluation, evaluate, sensor_statistics, trial_seed
-from evolution.experiment import load_experiment
-from evolution.reevaluate import _run_setup
-from evolution.stats import read_stats, without_timing
+from evolution.analysis.reevaluate import _run_setup
+from evolution.run import trainer as trainer_module
+from evolution.run.champion import genome_from_dict, load_champion
+from evolution.run.evaluate import Evaluation, evaluate, sensor_statistics, trial_seed
+from evolution.run.experiment import load_experiment
+from evolution.run.stats import read_stats, without_timing
 from gathering_env import Morphology, parallel_env
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from gathering_env.config import WorldConfig
-from gathering_env.sensing import sensor_bank
+from gathering_env.reference.sensing import sensor_bank
 from gathering_env.sensors import Morphology, SensorSpec
 
 pytestmark = pytest.mark.usefixtures("both_kernels")  # every test here runs on both kernels

@@ -1,7 +1,7 @@
 
 """The vectorised sensing kernel agrees with a plain per-robot, per-sensor, per-object loop.
 
-The reference below is written independently of ``gathering_env.sensing`` from SPEC
+The reference below is written independently of ``gathering_env.reference.sensing`` from SPEC
 section 3: nearest points by brute-force sampling-free geometry, cones by angles (atan2),
 walls by scanning the cone's edge and normal directions.
 """
@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gathering_env.config import WorldConfig
-from gathering_env.sensing import sensor_bank
+from gathering_env.reference.sensing import sensor_bank
 from gathering_env.sensors import SENSOR_TYPES, Morphology, SensorSpec
 
 pytestmark = pytest.mark.usefixtures("both_kernels")  # every test here runs on both kernels

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 from neat.innovation import InnovationTracker
 
-from evolution.breeding import NEATReproduction
-from evolution.genome import CPPNGenome
-from evolution.substrate import Substrate, decode
+from evolution.encodings.genome import CPPNGenome
+from evolution.encodings.substrate import Substrate, decode
+from evolution.reproduction.breeding import NEATReproduction
 from gathering_env import SENSOR_TYPES, parallel_env
 
 CFG = Path(__file__).resolve().parent.parent / "configs" / "hyperneat_m.neat.cfg"

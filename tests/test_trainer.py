@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from evolution.champion import ChampionError, load_champion
-from evolution.checkpoint import CheckpointError, load_checkpoint
 from evolution.cli import evolve_main, replay_main
-from evolution.evaluate import trial_seed
-from evolution.stats import read_stats, without_timing
+from evolution.run.champion import ChampionError, load_champion
+from evolution.run.checkpoint import CheckpointError, load_checkpoint
+from evolution.run.evaluate import trial_seed
+from evolution.run.stats import read_stats, without_timing
 
 TINY = """
 [experiment]

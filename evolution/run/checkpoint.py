@@ -6,7 +6,7 @@ file in the same directory, flushed, fsync'ed and renamed over the target, so a 
 process leaves either the old or the new checkpoint, never a torn one.
 
 Checkpoints are pickles: load only checkpoints you (or someone you trust) wrote.
-Champions and fronts use the safe JSON format of ``evolution.champion``.
+Champions and fronts use the safe JSON format of ``evolution.run.champion``.
 """
 
 from __future__ import annotations

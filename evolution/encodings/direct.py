@@ -1,6 +1,6 @@
 """NEAT-M (Hewland & Nitschke): a NEAT controller plus directly encoded sensor genes.
 
-``NEATMGenome`` is a ``neat.DefaultGenome`` (through ``evolution.breeding.BreedingGenome``)
+``NEATMGenome`` is a ``neat.DefaultGenome`` (through ``evolution.reproduction.breeding.BreedingGenome``)
 whose network has one input per possible sensor *slot* (``num_inputs`` = 10) and two outputs
 (left, right wheel). Alongside its node and connection genes it carries ``sensors``: slot ->
 ``SensorGene`` (type, bearing, orientation, range, fov). A slot without a sensor gene
@@ -8,7 +8,7 @@ contributes no input.
 
 Extra keys of the ``[NEATMGenome]`` config section (neat-python ``ConfigParameter``s; SPEC
 section 5 gives the original rates; with ``variation = one_operator`` each ``*_prob`` is the
-probability of that operator being *the* operator of an offspring, see ``evolution.breeding``)::
+probability of that operator being *the* operator of an offspring, see ``evolution.reproduction.breeding``)::
 
     sensor_types             = infrared ultrasonic colour camera bottom
     initial_sensors          = 3      # random sensors of a new genome
@@ -38,10 +38,9 @@ from typing import Any
 import numpy as np
 from neat.graphs import feed_forward_layers
 
+from evolution.encodings.controller import Layer, TeamController
+from evolution.reproduction.breeding import BreedingGenome, check_probability
 from gathering_env import SENSOR_TYPES, Morphology, SensorSpec
-
-from .breeding import BreedingGenome, check_probability
-from .controller import Layer, TeamController
 
 SENSOR_PARAMS = (
     ("sensor_types", str, "infrared ultrasonic colour camera bottom"),

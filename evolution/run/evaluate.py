@@ -31,11 +31,11 @@ def trial_seed(run_seed: int, generation: int, trial: int) -> int:
 def decode_genome(method: str, genome: Any, config: Any, substrate: Any = None):
     """(TeamController, Morphology) of a genome for the given method."""
     if method == "hyperneat-m":
-        from .substrate import Substrate, decode
+        from evolution.encodings.substrate import Substrate, decode
 
         return decode(genome, config, substrate if substrate is not None else Substrate())
     if method == "neat-m":
-        from .direct import decode_neat_m
+        from evolution.encodings.direct import decode_neat_m
 
         return decode_neat_m(genome, config)
     raise ValueError(f"method={method!r}; allowed: 'hyperneat-m', 'neat-m'")

@@ -26,7 +26,7 @@ the previous parents with their objectives, so each call (SPEC section 6):
    genomes altogether are further species admitted, in sort order, so that exactly N
    parents are always returned);
 5. gives each selected species offspring in proportion to its parents' summed rank scores
-   (largest remainder) and breeds them with ``evolution.breeding.breed``, the same routine
+   (largest remainder) and breeds them with ``evolution.reproduction.breeding.breed``, the same routine
    as the single-objective arm (truncation to the best parents by rank score, one operator
    per offspring; in crossover the better-ranked parent gives the disjoint genes).
 
@@ -46,8 +46,8 @@ import numpy as np
 from neat.config import ConfigParameter, DefaultClassConfig
 from neat.innovation import InnovationTracker
 
-from .breeding import breed
-from .pareto import nsga2_order
+from evolution.reproduction.breeding import breed
+from evolution.reproduction.pareto import nsga2_order
 
 PROGRESSIONS = ("round_robin", "by_front")
 REMOVED_KEYS = {

@@ -3,7 +3,7 @@
 Every backend returns results in the order of the genomes it was given, and every result
 depends only on (genome, run seed, generation), so all backends give identical statistics
 for the same seed. Each worker builds its environment once and reuses it
-(``evolution.evaluate`` keeps one env per process).
+(``evolution.run.evaluate`` keeps one env per process).
 
 Faults: an evaluation that raises, or a worker process that dies, is retried up to
 ``max_retries`` times; a genome that keeps failing gets the worst objectives
@@ -24,7 +24,7 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
-from .evaluate import Evaluation, evaluate
+from evolution.run.evaluate import Evaluation, evaluate
 
 BACKENDS = ("serial", "process", "ray")
 

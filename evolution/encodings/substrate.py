@@ -39,9 +39,8 @@ from typing import Any
 import neat
 import numpy as np
 
+from evolution.encodings.controller import Layer, TeamController
 from gathering_env import SENSOR_TYPES, Morphology, SensorSpec
-
-from .controller import Layer, TeamController
 
 CPPN_OUTPUTS = ("weight", "fov", "orientation", "range", "type", "bias")
 W, FOV, ORIENT, RANGE, TYPE, BIAS = range(6)

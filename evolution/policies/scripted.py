@@ -14,7 +14,8 @@ import math
 
 import numpy as np
 
-from .sensors import Morphology
+from evolution.policies.base import Policy
+from gathering_env.sensors import Morphology
 
 FORWARD = 0.8
 DRIFT = 0.3
@@ -81,4 +82,34 @@ class WanderTeam:
         return wheels
 
 
-__all__ = ["WanderTeam", "front_ultrasonic"]
+def random_policy() -> Policy:
+    state = {"rng": np.random.default_rng(0)}
+
+    def act(obs):
+        return state["rng"].uniform(-1.0, 1.0, (obs.shape[0], 2))
+
+    def reset(seed):
+        state["rng"] = np.random.default_rng(seed)
+
+    return Policy("random", Morphology.khepera_iii(), act, reset)
+
+
+def heuristic_policy() -> Policy:
+    """Search pattern on Khepera III readings (bottom, IR +40, IR -40, US 0, US +90, US -90)."""
+
+    def act(obs):
+        wheels = np.tile([1.0, 0.85], (obs.shape[0], 1))
+        blocked = (obs[:, 3] > 0.75) | (obs[:, 1] > 0.0) | (obs[:, 2] > 0.0)
+        wheels[blocked] = [1.0, -1.0]
+        return wheels
+
+    return Policy("heuristic", Morphology.khepera_iii(), act)
+
+
+def wander_policy() -> Policy:
+    """The benchmark's explorer (``evolution.policies.scripted.WanderTeam``) on Khepera III."""
+    team = WanderTeam(Morphology.khepera_iii())
+    return Policy("wander", team.morphology, team.act, team.reset)
+
+
+__all__ = ["WanderTeam", "front_ultrasonic", "random_policy", "heuristic_policy", "wander_policy"]

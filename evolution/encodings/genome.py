@@ -1,11 +1,11 @@
 """The HyperNEAT-M CPPN genome on neat-python.
 
-``CPPNGenome`` is a ``neat.DefaultGenome`` (through ``evolution.breeding.BreedingGenome``)
+``CPPNGenome`` is a ``neat.DefaultGenome`` (through ``evolution.reproduction.breeding.BreedingGenome``)
 whose config section (``[CPPNGenome]``) must declare 4 inputs (x1, y1, x2, y2 of the two
 substrate nodes; neat-python gives every node its own bias, so no explicit bias input is
 needed) and 6 outputs (weight, fov, orientation, range, type, bias-weight, in that order;
-see ``evolution.substrate``). Everything else (activation set, mutation rates, initial
-connection density, the breeding keys of ``evolution.breeding``) comes from the config file
+see ``evolution.encodings.substrate``). Everything else (activation set, mutation rates, initial
+connection density, the breeding keys of ``evolution.reproduction.breeding``) comes from the config file
 through neat-python's ``parse_config``; unknown keys in the section are an error.
 
 **Output activations.** The decoding maps [-1, 1] onto sensor-type bands, parameter ranges
@@ -27,8 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from .breeding import BreedingGenome
-from .substrate import CPPN_OUTPUTS
+from evolution.encodings.substrate import CPPN_OUTPUTS
+from evolution.reproduction.breeding import BreedingGenome
 
 CPPN_INPUTS = ("x1", "y1", "x2", "y2")
 

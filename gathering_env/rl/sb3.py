@@ -4,7 +4,7 @@ Every robot of every world is one sub-environment, so a single SB3 policy (PPO, 
 is shared by the whole team and trained on all robots' experience at once::
 
     from stable_baselines3 import PPO
-    from gathering_env.sb3 import GatheringVecEnv
+    from gathering_env.rl.sb3 import GatheringVecEnv
 
     venv = GatheringVecEnv(num_worlds=4, seed=0, environment=1, max_cycles=2000, reward="shaped")
     model = PPO("MlpPolicy", venv).learn(200_000)       # timesteps count robot-steps
@@ -40,8 +40,8 @@ import numpy as np
 from gymnasium import spaces
 from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvIndices
 
-from .sensors import Morphology
-from .vector import VectorSimulation
+from ..sensors import Morphology
+from ..vector import VectorSimulation
 
 SEED_LIMIT = 2**31
 """Episode seeds are drawn uniformly from [0, SEED_LIMIT)."""

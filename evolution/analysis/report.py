@@ -12,8 +12,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .analysis import SELECTION_POINTS, Analysis  # noqa: E402
-from .guard import check_output_dir  # noqa: E402
+from evolution.analysis.fronts import SELECTION_POINTS, Analysis  # noqa: E402
+from evolution.guard import check_output_dir  # noqa: E402
 
 ENV_COLOURS = {1: "tab:blue", 2: "tab:orange", 3: "tab:red"}
 POINT_MARKERS = {"max": "^", "mean": "s", "knee": "D", "epsilon": "P"}

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from .world import GatheringWorld
+from ..world import GatheringWorld
 
 
 def pickup_candidates(world: GatheringWorld, gathered: np.ndarray) -> list[tuple[int, int]]:

@@ -5,7 +5,7 @@ training score a run ever saw, and an MO front holds the genomes whose training 
 happened to be non-dominated. Their training scores are therefore biased upward.
 ``reevaluate_run`` runs the champion (``champion.json``) and every front genome
 (``front/*.json``) of a run again, ``trials`` times, on **held-out seeds**, through the
-evaluation backends (``evolution.backends``), and caches the results in the run directory.
+evaluation backends (``evolution.run.backends``), and caches the results in the run directory.
 
 Held-out seeds. Training trial seeds are ``trial_seed(run seed, generation, trial)``, i.e.
 ``SeedSequence([run seed, generation, trial])`` with generation < the run's generations.
@@ -27,10 +27,10 @@ import json
 from pathlib import Path
 from typing import Any
 
-from .backends import EvalContext, make_evaluator
-from .champion import ChampionError, genome_from_dict
-from .checkpoint import atomic_write_bytes
-from .evaluate import trial_seed
+from evolution.run.backends import EvalContext, make_evaluator
+from evolution.run.champion import ChampionError, genome_from_dict
+from evolution.run.checkpoint import atomic_write_bytes
+from evolution.run.evaluate import trial_seed
 
 REEVALUATE_TRIALS = 20
 """Default K of ``gathering-analyze --reevaluate``."""
@@ -62,9 +62,9 @@ def heldout_seeds(run_seed: int, generations: int, trials: int, k: int) -> list[
 
 def _run_setup(run_dir: Path) -> tuple[Any, Any, Any]:
     """(experiment, neat config, substrate) of a run directory, from its own copies."""
-    from .champion import read_json
-    from .experiment import ExperimentError, experiment_from_run
-    from .trainer import make_neat_config, substrate_for
+    from evolution.run.champion import read_json
+    from evolution.run.experiment import ExperimentError, experiment_from_run
+    from evolution.run.trainer import make_neat_config, substrate_for
 
     path = run_dir / "experiment.json"
     try:
@@ -103,7 +103,7 @@ def reevaluate_run(run_dir: Path, trials: int, workers: int | None = None, backe
 
     Args:
         run_dir: a run directory. trials: K held-out trials per genome (>= 1).
-        workers, backend: as for ``evolution.backends.make_evaluator``.
+        workers, backend: as for ``evolution.run.backends.make_evaluator``.
         generations: generations the run trained (default: from its experiment).
 
     Returns:

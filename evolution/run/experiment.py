@@ -18,7 +18,7 @@ Layout (every key optional except where noted; defaults are the paper's, SPEC se
     environment = 2
     max_cycles = 10000
 
-    [substrate]                  # HyperNEAT-M substrate options (evolution.substrate.Substrate)
+    [substrate]                  # HyperNEAT-M substrate options (evolution.encodings.substrate.Substrate)
     bottom_on_node0 = true
 
 ``load_experiment(path, overrides)`` validates everything and raises ``ExperimentError``
@@ -255,7 +255,7 @@ def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str,
     except (ValueError, TypeError) as err:
         raise ExperimentError(f"{source}: [environment] {err}") from None
     if sub_section and method == "hyperneat-m":
-        from .substrate import Substrate
+        from evolution.encodings.substrate import Substrate
 
         try:
             Substrate(**sub_section)

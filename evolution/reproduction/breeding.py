@@ -1,7 +1,7 @@
 """One breeding routine for both arms: truncation, then one variation operator per offspring.
 
 SO and MO runs differ only in how parents are *selected* (NEAT fitness sharing with
-stagnation in ``NEATReproduction``, speciated NSGA-II in ``evolution.mods``); both then breed
+stagnation in ``NEATReproduction``, speciated NSGA-II in ``evolution.reproduction.mods``); both then breed
 each species' offspring with ``breed``, so Table 4 compares selection and nothing else.
 
 ``breed`` (SPEC sections 5 and 6.5, the original's Encog scheme):

@@ -18,10 +18,9 @@ from typing import Any
 
 import numpy as np
 
+from evolution.run.checkpoint import atomic_write_bytes
+from evolution.run.evaluate import Evaluation
 from gathering_env import SENSOR_TYPES
-
-from .checkpoint import atomic_write_bytes
-from .evaluate import Evaluation
 
 OBJECTIVE_NAMES = ("task", "morphology", "controller")
 TIMING_KEYS = ("seconds", "seconds_env", "seconds_controller", "seconds_decode")

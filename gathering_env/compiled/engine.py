@@ -22,11 +22,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..config import WorldConfig
+from ..rewards import RewardShaper
+from ..sensors import Morphology
+from ..world import STATE_ARRAYS, GatheringWorld
 from . import kernels
-from .config import WorldConfig
-from .rewards import RewardShaper
-from .sensors import Morphology
-from .world import STATE_ARRAYS, GatheringWorld
 
 
 class CompiledWorlds:

@@ -12,9 +12,9 @@ Three kernels, each over a batch of W independent worlds of the same configurati
 * ``sense``: the readings of every sensor of every robot of every world.
 
 Each kernel is a plain loop (worlds x robots x objects x sensors) and reproduces the
-numpy reference (``gathering_env.sensing``, ``heuristics``, ``scoring`` and
+numpy reference (``gathering_env.reference.sensing``, ``heuristics``, ``scoring`` and
 ``GatheringWorld``) operation for operation, so both give the same numbers; the tests
-compare them. Geometry and readings are documented in ``gathering_env.sensing``.
+compare them. Geometry and readings are documented in ``gathering_env.reference.sensing``.
 
 Kernels are compiled on first use and cached on disk (``cache=True``), so later imports,
 and process-pool workers, load the machine code instead of compiling again.
@@ -27,7 +27,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .sensors import TYPE_CODES
+from ..sensors import TYPE_CODES
 
 IR, US, COLOUR, CAMERA, BOTTOM = (TYPE_CODES[t] for t in ("infrared", "ultrasonic", "colour", "camera", "bottom"))
 

@@ -4,7 +4,7 @@ A champion file holds the decoded morphology and controller weights (enough to r
 team), the objectives it reached, the environment it was evolved in, and the genome's
 genes as plain data::
 
-    {"format": "gathering-evolution/champion", "version": 1,
+    {"format": "gathering-evolution/run/champion", "version": 1,
      "method": "hyperneat-m", "experiment": "S2", "generation": 41, "genome_key": 6130,
      "objectives": {"task": 57.3, "morphology": 61.0, "controller": 82.0},
      "environment": {"environment": 2, "max_cycles": 10000},
@@ -19,11 +19,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from evolution.run.checkpoint import atomic_write_bytes
 from gathering_env import Morphology, WorldConfig
 
-from .checkpoint import atomic_write_bytes
-
-FORMAT = "gathering-evolution/champion"
+FORMAT = "gathering-evolution/run/champion"
 VERSION = 1
 
 
@@ -77,7 +76,7 @@ def genome_from_dict(data: dict[str, Any], config: Any) -> Any:
                 setattr(gene, attr.name, c[attr.name])
             genome.connections[key] = gene
         if "sensors" in data:
-            from .direct import SensorGene
+            from evolution.encodings.direct import SensorGene
 
             genome.sensors = {int(k): SensorGene(**v) for k, v in sorted(data["sensors"].items(), key=lambda kv: int(kv[0]))}
     except (KeyError, TypeError, ValueError, AttributeError) as err:
@@ -138,7 +137,7 @@ def save_champion(path: Path, *, method: str, experiment: str, generation: int, 
 
 def load_champion(path: str | Path) -> Champion:
     """Read a champion file. Raises ``ChampionError`` naming the file and the field."""
-    from .controller import TeamController
+    from evolution.encodings.controller import TeamController
 
     path = Path(path)
     doc = read_json(path, "champion file", ChampionError)

@@ -29,8 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .config import WorldConfig
-from .sensors import TYPE_CODES, Morphology
+from ..config import WorldConfig
+from ..sensors import TYPE_CODES, Morphology
 
 IR, US, COLOUR, CAMERA, BOTTOM = (TYPE_CODES[t] for t in ("infrared", "ultrasonic", "colour", "camera", "bottom"))
 
@@ -230,7 +230,7 @@ def sensor_bank(morphology: Morphology, config: WorldConfig, block_half_sizes: n
     """The sensing of ``config.kernel``: this module's ``SensorBank`` ('numpy') or
     ``kernels.CompiledSensorBank`` ('compiled'); both have ``read(...)`` as above."""
     if config.kernel == "compiled":
-        from .kernels import CompiledSensorBank
+        from ..compiled.kernels import CompiledSensorBank
 
         return CompiledSensorBank(morphology, config, block_half_sizes, block_needs)
     return SensorBank(morphology, config, block_half_sizes, block_needs)

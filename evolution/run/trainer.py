@@ -4,7 +4,7 @@ One call of ``Trainer.run()`` evolves an ``Experiment`` into a run directory::
 
     RUN_DIR/experiment.json        the resolved experiment (what was run)
     RUN_DIR/neat.cfg               a copy of the neat-python config used
-    RUN_DIR/stats.jsonl, stats.csv one record per generation (evolution.stats)
+    RUN_DIR/stats.jsonl, stats.csv one record per generation (evolution.run.stats)
     RUN_DIR/checkpoints/gen-NNNN.ckpt  state before generation NNNN is evaluated
     RUN_DIR/champion.json          best genome so far by task performance (JSON, no pickle)
     RUN_DIR/stats.png              fitness and simplicity over generations (at the end)
@@ -31,15 +31,14 @@ from typing import Any
 
 import neat
 
+from evolution.guard import UsageError, check_output_dir, describe_os_error
+from evolution.run.backends import EvalContext, make_evaluator
+from evolution.run.champion import read_json, save_champion
+from evolution.run.checkpoint import CheckpointError, load_checkpoint, save_checkpoint
+from evolution.run.evaluate import Evaluation, decode_genome
+from evolution.run.experiment import Experiment, ExperimentError, experiment_from_run
+from evolution.run.stats import append_stats, generation_record, read_stats, write_stats
 from gathering_env import morphological_complexity as morphology_simplicity
-
-from .backends import EvalContext, make_evaluator
-from .champion import read_json, save_champion
-from .checkpoint import CheckpointError, load_checkpoint, save_checkpoint
-from .evaluate import Evaluation, decode_genome
-from .experiment import Experiment, ExperimentError, experiment_from_run
-from .guard import UsageError, check_output_dir, describe_os_error
-from .stats import append_stats, generation_record, read_stats, write_stats
 
 CHECKPOINT_DIR = "checkpoints"
 KEEP_CHECKPOINTS = 3
@@ -50,10 +49,10 @@ RUN_IDENTITY = ("method", "objectives", "seed", "population", "trials", "environ
 def genome_class(method: str) -> type:
     """The neat-python genome class of a method."""
     if method == "hyperneat-m":
-        from .genome import CPPNGenome
+        from evolution.encodings.genome import CPPNGenome
 
         return CPPNGenome
-    from .direct import NEATMGenome
+    from evolution.encodings.direct import NEATMGenome
 
     return NEATMGenome
 
@@ -64,15 +63,15 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
     Single-objective runs use ``NEATReproduction`` (neat-python's ``DefaultReproduction``
     selection, its ``[NEATReproduction]`` section); multi-objective runs use
     ``MODSReproduction`` (its ``[MODSReproduction]`` section in the same file). Both breed
-    with ``evolution.breeding.breed``.
+    with ``evolution.reproduction.breeding.breed``.
     """
     path = experiment.neat_config
     if experiment.multi_objective:
-        from .mods import MODSReproduction
+        from evolution.reproduction.mods import MODSReproduction
 
         reproduction: type = MODSReproduction
     else:
-        from .breeding import NEATReproduction
+        from evolution.reproduction.breeding import NEATReproduction
 
         reproduction = NEATReproduction
     try:
@@ -138,7 +137,7 @@ def check_neat_config(config: neat.Config, path: Path) -> None:
         if default not in options and default not in ("random", "none"):
             raise bad(section, f"{gene}_default", default, f"random, none or one of {gene}_options")
     if config.genome_type is not _cppn_genome():  # NEAT-M networks run on the team controller
-        from .controller import ACTIVATIONS
+        from evolution.encodings.controller import ACTIVATIONS
 
         unknown = [name for name in genome.activation_options if name not in ACTIVATIONS]
         if unknown:
@@ -173,7 +172,7 @@ def check_neat_config(config: neat.Config, path: Path) -> None:
 def substrate_for(experiment: Experiment) -> Any:
     if experiment.method != "hyperneat-m":
         return None
-    from .substrate import Substrate
+    from evolution.encodings.substrate import Substrate
 
     try:
         return Substrate(**experiment.substrate)
@@ -211,7 +210,7 @@ class Trainer:
         workers: evaluation processes (None = all local cores, 1 = serial).
         resume: continue from the newest readable checkpoint in ``run_dir`` (or ``resume_from``).
         progress: show a progress bar with ETA (tqdm).
-        backend: 'serial', 'process' or 'ray' (``evolution.backends``); ray_address: join this
+        backend: 'serial', 'process' or 'ray' (``evolution.run.backends``); ray_address: join this
             Ray cluster instead of starting a local one. max_retries: per failing evaluation.
         overrides: as for ``load_experiment``, applied to the run's experiment when
             ``experiment`` is None (only ``generations`` and ``name`` may differ from the run).
@@ -577,7 +576,7 @@ class Trainer:
                           controller=controller, objectives=values, environment=exp.environment)
 
     def _plot(self) -> None:
-        from .plots import plot_run
+        from evolution.run.plots import plot_run
 
         if self.records:
             plot_run(self.records, self.run_dir / "stats.png", title=self.experiment.name)

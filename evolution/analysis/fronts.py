@@ -15,7 +15,7 @@ also the morphology (or more objectives). For every group:
   comparing the SO champions with each selection point, for ft and for C (Table 4).
 
 Which ft: with ``reevaluate = K`` > 0 every champion and front genome is re-run K times on
-held-out seeds (``evolution.reevaluate``) and those scores replace the training scores
+held-out seeds (``evolution.analysis.reevaluate``) and those scores replace the training scores
 (then each run's front is re-filtered to its non-dominated points); with 0 the training
 scores are used, which are biased upward (best-of-many noisy evaluations). C does not
 depend on the seeds. ``Analysis.scores`` says which were used.
@@ -33,9 +33,9 @@ from typing import Any
 import numpy as np
 from scipy import stats as sps
 
-from .champion import ChampionError, champion_objectives, read_json
-from .pareto import non_dominated_fronts
-from .stats import read_stats
+from evolution.reproduction.pareto import non_dominated_fronts
+from evolution.run.champion import ChampionError, champion_objectives, read_json
+from evolution.run.stats import read_stats
 
 SELECTION_POINTS = ("max", "mean", "knee", "epsilon")
 EPSILON = 0.10
@@ -232,12 +232,12 @@ def analyse(run_dirs: list[Path], reevaluate: int = 0, workers: int | None = Non
             unique[key] = Path(p)
     runs = [load_run(p) for p in unique.values()]
     if reevaluate:
-        from .reevaluate import reevaluate_run
+        from evolution.analysis.reevaluate import reevaluate_run
 
         for run in runs:
             apply_reevaluation(run, reevaluate_run(run.path, reevaluate, workers, backend, len(run.records)))
         scores = (f"held-out: every champion and front genome re-evaluated on {reevaluate} trials with seeds "
-                  "disjoint from training (evolution.reevaluate)")
+                  "disjoint from training (evolution.analysis.reevaluate)")
     else:
         scores = "training: the scores recorded during evolution (best-of-many, biased upward)"
     so_by_env: dict[int, list[tuple[float, float]]] = defaultdict(list)
