@@ -111,7 +111,7 @@ def evolve_main(argv: list[str] | None = None) -> int:
         raise UsageError(f"--resume-from {args.resume_from}: is a folder; allowed: a checkpoint file "
                          "(RUN_DIR/checkpoints/gen-NNNN.ckpt), or --resume RUN_DIR")
     if out is None and args.resume_from is not None:
-        from evolution.run.trainer import run_dir_of
+        from evolution.run.rundir import run_dir_of
 
         out = run_dir_of(args.resume_from)
         if out is None:

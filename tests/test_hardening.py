@@ -230,7 +230,7 @@ def test_unusable_paths_and_options_are_one_line_errors(finished, tmp_path, caps
 
 
 def test_unwritable_run_directory_mid_run_is_one_line_and_resumable(tmp_path, capsys, monkeypatch):
-    from evolution.run import trainer as trainer_module
+    from evolution.run import recorder as trainer_module
 
     exp = write_tiny(tmp_path, generations=2)
     real = trainer_module.append_stats

@@ -64,7 +64,7 @@ def _run_setup(run_dir: Path) -> tuple[Any, Any, Any]:
     """(experiment, neat config, substrate) of a run directory, from its own copies."""
     from evolution.run.champion import read_json
     from evolution.run.experiment import ExperimentError, experiment_from_run
-    from evolution.run.trainer import make_neat_config, substrate_for
+    from evolution.run.neat_setup import make_neat_config, substrate_for
 
     path = run_dir / "experiment.json"
     try:
