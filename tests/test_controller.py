@@ -78,3 +78,39 @@ def test_neat_m_network_matches_neat_feed_forward_per_robot():
         for i in range(5):
             expected = 2.0 * np.array(reference.activate(obs[i].tolist())) - 1.0
             np.testing.assert_allclose(got[i], expected, atol=1e-9)
+
+
+def test_wander_team_follows_its_documented_rule():
+    """Hand trace: 20 blocked readings start a 10-step spin in a random direction, the counter
+    is frozen while spinning, drifts are redrawn every 50 steps."""
+    from evolution.policies.scripted import BLOCKED_STEPS, DRIFT_PERIOD, FORWARD, SPIN_STEPS, WanderTeam
+
+    team = WanderTeam(seed=3)
+    front = team.front
+    blocked = np.zeros((2, 6))
+    blocked[0, front] = 1.0  # robot 0 always sees a wall ahead, robot 1 never
+    rng = np.random.default_rng(3)
+    drift = rng.uniform(-0.3, 0.3, 2)
+    spins, signs = [], []
+    for t in range(BLOCKED_STEPS + SPIN_STEPS + BLOCKED_STEPS + 2):
+        wheels = team.act(blocked)
+        if t == 0:
+            np.testing.assert_allclose(wheels[1], [FORWARD - drift[1], FORWARD + drift[1]])
+        is_spin = abs(wheels[0, 0]) == 1.0 and wheels[0, 0] == -wheels[0, 1]
+        spins.append(is_spin)
+        if is_spin:
+            signs.append(wheels[0, 0])
+        assert not (abs(wheels[1, 0]) == 1.0 and wheels[1, 0] == -wheels[1, 1])
+    # steps 0..18 count to 19, step 19 reaches 20 and spins (steps 19..28), frozen meanwhile;
+    # the next spin needs 20 fresh blocked steps after it: steps 29..48 -> spin from step 48 (..51)
+    expected = [False] * (BLOCKED_STEPS - 1) + [True] * SPIN_STEPS + [False] * (BLOCKED_STEPS - 1) + [True] * 4
+    assert spins == expected
+    # the direction of each spin is drawn when it starts (seed 3: both directions occur over seeds)
+    directions = set()
+    for seed in range(8):
+        team = WanderTeam(seed=seed)
+        for _ in range(BLOCKED_STEPS):
+            wheels = team.act(blocked)
+        directions.add(float(wheels[0, 0]))
+    assert directions == {1.0, -1.0}
+    assert DRIFT_PERIOD == 50

@@ -177,7 +177,7 @@ def test_whole_episodes_are_identical_on_both_kernels(world):
 def test_episode_that_terminates_early_is_identical():
     world = dict(SMALL, block_counts=(1, 0, 0), num_robots=15)
     finished = 0
-    for seed in (4, 0, 5):   # these end after 222 and 847 steps, and by truncation at 1000
+    for seed in (4, 0, 2):   # these end after 224 steps, by truncation at 1000, and after 589 steps
         ref, want = _episode("numpy", 1000, Morphology.khepera_iii(), seed, **world)
         sim, got = _episode("compiled", 1000, Morphology.khepera_iii(), seed, **world)
         np.testing.assert_array_equal(np.asarray(got["pose"]), np.asarray(want["pose"]))

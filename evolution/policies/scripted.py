@@ -1,11 +1,13 @@
 """Scripted team policies that need no training: baselines and benchmark workloads.
 
 ``WanderTeam`` is the explorer of the speed benchmark matched with the original Java
-simulator: every robot drives forward at 0.8 of top speed with a turning drift, redrawn
-uniformly in [-0.3, 0.3] every 50 steps; a robot whose front ultrasonic has read >= 0.999
-(an obstacle within 5 % of its range) for 20 consecutive steps spins on the spot for 10
-steps. It works on any number of robots at once (a team, or W teams stacked), so it is
-also a cheap, moving baseline for comparisons.
+simulator, and the scripted baseline of every learning comparison: every robot drives forward
+at 0.8 of top speed with a turning drift, redrawn uniformly in [-0.3, 0.3] every 50 steps; a
+robot whose front ultrasonic has read >= 0.999 (an obstacle within 5 % of its range) for 20
+consecutive steps spins on the spot for 10 steps, in a direction drawn at random (left or right,
+each 1/2) when the spin starts; the blocked counter is frozen (not counted) while it spins. It
+works on any number of robots at once (a team, or W teams stacked), so it is also a cheap,
+moving baseline for comparisons.
 """
 
 from __future__ import annotations
@@ -55,7 +57,7 @@ class WanderTeam:
     def reset(self, seed: int | None = None) -> None:
         self.rng = np.random.default_rng(seed)
         self.t = 0
-        self.drift = self.blocked = self.spin = None
+        self.drift = self.blocked = self.spin = self.spin_sign = None
 
     def act(self, obs: np.ndarray) -> np.ndarray:
         m = obs.shape[0]
@@ -63,6 +65,7 @@ class WanderTeam:
             self.drift = np.zeros(m)
             self.blocked = np.zeros(m, dtype=np.int64)
             self.spin = np.zeros(m, dtype=np.int64)
+            self.spin_sign = np.ones(m)
             self.t = 0
         if self.t % DRIFT_PERIOD == 0:
             self.drift = self.rng.uniform(-DRIFT, DRIFT, m)
@@ -70,14 +73,19 @@ class WanderTeam:
         wheels = np.empty((m, 2))
         wheels[:, 0] = FORWARD - self.drift
         wheels[:, 1] = FORWARD + self.drift
+        spinning = self.spin > 0
         if self.front is not None:
             close = obs[:, self.front] >= BLOCKED_READING
-            self.blocked = np.where(close, self.blocked + 1, 0)
+            # frozen while spinning: a spinning robot neither counts nor resets its counter
+            self.blocked = np.where(spinning, self.blocked, np.where(close, self.blocked + 1, 0))
             start = self.blocked >= BLOCKED_STEPS
-            self.spin[start] = SPIN_STEPS
-            self.blocked[start] = 0
-        spinning = self.spin > 0
-        wheels[spinning] = (1.0, -1.0)
+            if start.any():
+                self.spin[start] = SPIN_STEPS
+                self.spin_sign[start] = np.where(self.rng.random(int(start.sum())) < 0.5, 1.0, -1.0)
+                self.blocked[start] = 0
+            spinning = self.spin > 0
+        wheels[spinning, 0] = self.spin_sign[spinning]
+        wheels[spinning, 1] = -self.spin_sign[spinning]
         self.spin[spinning] -= 1
         return wheels
 
