@@ -44,7 +44,7 @@ def test_list_prints_every_preset_with_its_first_comment_sentence(capsys):
     assert listed["S1"] == "Experiment S1 of the paper: single objective (task performance), environment 1."
     assert listed["M3"].startswith("Experiment M3 of the paper: multi-objective")
     # a sentence that continues on the next comment line is joined
-    assert listed["neat_m.neat.cfg"].endswith("plus sensor genes), SPEC section 5.")
+    assert listed["neat_m.neat.cfg"].endswith("plus sensor genes), docs/model.md §5.")
     assert preset_description("quick") == listed["quick"]
 
 

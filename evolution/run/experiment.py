@@ -1,6 +1,6 @@
 """Experiment files: one TOML file describes a run (method, objectives, budget, world).
 
-Layout (every key optional except where noted; defaults are the paper's, SPEC section 7)::
+Layout (every key optional except where noted; defaults are the paper's, docs/model.md §7)::
 
     [experiment]
     name = "S2"                  # label used in file names and the analysis
