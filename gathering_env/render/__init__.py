@@ -72,6 +72,8 @@ from .drawing import (
     morphology_rows,
     team_cone_cover,
 )
+from .export import save_png, save_video
+from .figures import film_strip, sensor_layout
 from .options import (
     AUTO_CONES_COVER,
     CONE_CHOICES,
@@ -88,10 +90,6 @@ from .options import (
 from .renderer import (
     KEYS,
     Renderer,
-    film_strip,
-    save_png,
-    save_video,
-    sensor_layout,
 )
 
 __all__ = [
