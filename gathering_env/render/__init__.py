@@ -87,10 +87,8 @@ from .options import (
     parse_cones,
     parse_view,
 )
-from .renderer import (
-    KEYS,
-    Renderer,
-)
+from .panel import KEYS
+from .renderer import Renderer
 
 __all__ = [
     "RGB",

@@ -228,10 +228,10 @@ def draw_arena(r: Renderer, surf: pygame.Surface) -> None:
 
 def draw_trails(r: Renderer, surf: pygame.Surface) -> None:
     """Each robot's recorded path, fading from the floor colour (oldest) to ``TRAIL``."""
-    if r._options.trail <= 0 or len(r._positions) < 2:
+    if r._options.trail <= 0 or len(r._history.positions) < 2:
         return
     pg = r._pg
-    pts = r.to_screen(np.stack(r._positions))                     # (T, N, 2), oldest first
+    pts = r.to_screen(np.stack(r._history.positions))             # (T, N, 2), oldest first
     t = len(pts)
     width = 3 if r.scale >= 30 else 2
     for age in range(t - 1):

@@ -1,33 +1,23 @@
-"""The Renderer: pygame drawing of the gathering world (see the package docstring, ``gathering_env.render``)."""
+"""The ``Renderer``: options, the view (world units -> pixels), the recorded history, render/show/close.
+
+A frame is drawn by ``Renderer.draw``: the layers of ``drawing`` (arena, trails, cones, blocks,
+robots) in the arena view, then the ``panel``; ``render`` returns it (``"rgb_array"``) or shows
+it in the ``window`` (``"human"``). Those modules are functions of the renderer's state. What
+a frame shows is described in the package docstring (``gathering_env.render``).
+"""
 
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..config import BLOCK_TYPE_NAMES, WorldConfig
-from ..sensors import SENSOR_TYPES
+from ..config import WorldConfig
 from .drawing import (
-    BLOCK_COLOURS,
-    FLOOR,
-    GATHERED_EDGE,
-    GATHERED_SHADE,
-    HEADING,
-    MUTED,
     PAGE,
-    RGB,
-    ROBOT,
-    ROBOT_ATTACHED,
-    SENSOR_COLOURS,
-    TRAIL,
-    ZONE_EDGE,
     _surface_to_array,
     _Text,
-    cone_colour_on,
-    cone_sensors,
     draw_arena,
     draw_blocks,
     draw_cones,
@@ -36,16 +26,56 @@ from .drawing import (
     team_cone_cover,
 )
 from .options import AUTO_CONES_COVER, DEFAULT_SIZE_PX, FOLLOW_SPAN, ZONE_MARGIN, RenderOptions
+from .panel import draw_keys, draw_panel, panel_width
+from .window import show
 
 if TYPE_CHECKING:  # pragma: no cover
     import pygame
 
     from ..simulation import GatheringSimulation
 
-KEYS = "space pause   right step   +/- speed   c cones   esc close"
-"""The ``"human"`` window's keys, as listed in the window."""
 
-_CONE_ORDER = [t for t in SENSOR_TYPES if t != "bottom"]
+class _History:
+    """The episode so far, for the sparkline and trails: gathered value per step, recent positions."""
+
+    def __init__(self) -> None:
+        self.last_step = -1
+        self.steps: list[int] = []
+        self.values: list[float] = []
+        self.positions: list[np.ndarray] = []
+
+    def record(self, sim: GatheringSimulation, keep: int) -> None:
+        """Note ``sim``'s step (see ``Renderer.record``); keep ``keep`` + 1 positions (none if 0)."""
+        steps = int(sim.steps)
+        if steps == self.last_step and steps != 0:
+            return
+        if steps == 0 or steps < self.last_step:
+            self.steps, self.values, self.positions = [], [], []
+        self.last_step = steps
+        self.steps.append(steps)
+        self.values.append(float(sim.gathered_value))
+        if keep > 0:
+            self.positions.append(np.array(sim.world.robot_pos, dtype=float))
+            del self.positions[:-(keep + 1)]
+
+
+def _view_window(config: WorldConfig, opts: RenderOptions,
+                 sim: GatheringSimulation) -> tuple[float, float, float | None]:
+    """The view's centre (world units) and span (None: the whole arena) for ``opts.view``."""
+    follow = opts.follow
+    if follow is not None:
+        x, y = sim.world.robot_pos[follow]
+        return float(x), float(y), FOLLOW_SPAN
+    if opts.view == "zone":
+        x0, y0, x1, y1 = config.zone_rect
+        span = max(x1 - x0, y1 - y0) + 2 * ZONE_MARGIN
+        edge = 0.5                                               # show a little of the wall
+        centre = []
+        for c, extent in ((0.5 * (x0 + x1), config.arena_width), (0.5 * (y0 + y1), config.arena_height)):
+            lo, hi = 0.5 * span - edge, extent + edge - 0.5 * span
+            centre.append(0.5 * extent if lo > hi else min(max(c, lo), hi))
+        return centre[0], centre[1], span
+    return 0.5 * config.arena_width, 0.5 * config.arena_height, None
 
 
 class Renderer:
@@ -58,7 +88,7 @@ class Renderer:
         size_px: side of the square arena view in pixels (>= 64).
         fps: frame rate the ``"human"`` window is throttled to (frames per second).
         **options: the other render options (``cones``, ``view``, ``trail``, ``panel``,
-            ``min_robot_px``; see the module docstring).
+            ``min_robot_px``; see ``gathering_env.render``).
 
     A frame is ``(size_px, size_px + panel_px, 3)``: the arena view on the left, the panel (if
     any) on the right.
@@ -88,11 +118,7 @@ class Renderer:
         self._clock: pygame.time.Clock | None = None
         self.paused = False
         self._cone_toggle = 0            # "human" key c: 0 = options.cones, 1 = "all", 2 = "none"
-        # History of the episode, recorded by ``record`` (every step when driven by the env).
-        self._last_step = -1
-        self._value_steps: list[int] = []
-        self._values: list[float] = []
-        self._positions: list[np.ndarray] = []
+        self._history = _History()      # recorded by ``record`` (every step when driven by the env)
         self._configure(opts)
 
     # ------------------------------------------------------------------ options and layout
@@ -115,12 +141,7 @@ class Renderer:
         self._text = _Text(pg, max(13, size // 32))
         self._small = _Text(pg, max(12, size // 40))
         self.wall_px = max(2, int(round(size / 100)))
-        if opts.panel:
-            gap = max(6, self._text.width("00"))
-            table_w = self._text.table_columns(gap)[2] if self._text.font is not None else 0
-            self.panel_px = max(size // 3, table_w + 2 * self._margin)
-        else:
-            self.panel_px = 0
+        self.panel_px = panel_width(self._text, size, self._margin) if opts.panel else 0
         shape = (size + self.panel_px, size)
         if getattr(self, "_surface", None) is None or self._surface.get_size() != shape:
             self._surface = pg.Surface(shape)
@@ -144,24 +165,6 @@ class Renderer:
         (left, top), (right, bottom) = self.to_screen(np.array([[0.0, cfg.arena_height], [cfg.arena_width, 0.0]]))
         left, top = int(round(left)), int(round(top))
         self.arena_rect = (left, top, int(round(right)) - left, int(round(bottom)) - top)
-
-    def _view_for(self, sim: GatheringSimulation) -> None:
-        cfg, opts = self.config, self._options
-        follow = opts.follow
-        if follow is not None:
-            x, y = sim.world.robot_pos[follow]
-            self._set_view(float(x), float(y), FOLLOW_SPAN)
-        elif opts.view == "zone":
-            x0, y0, x1, y1 = cfg.zone_rect
-            span = max(x1 - x0, y1 - y0) + 2 * ZONE_MARGIN
-            edge = 0.5                                           # show a little of the wall
-            centre = []
-            for c, extent in ((0.5 * (x0 + x1), cfg.arena_width), (0.5 * (y0 + y1), cfg.arena_height)):
-                lo, hi = 0.5 * span - edge, extent + edge - 0.5 * span
-                centre.append(0.5 * extent if lo > hi else min(max(c, lo), hi))
-            self._set_view(centre[0], centre[1], span)
-        else:
-            self._set_view(0.5 * cfg.arena_width, 0.5 * cfg.arena_height, None)
 
     # ------------------------------------------------------------------ geometry
     def to_screen(self, xy: np.ndarray) -> np.ndarray:
@@ -201,18 +204,7 @@ class Renderer:
         The env calls this after every reset and step; ``render`` calls it too. A step count
         lower than the last one (or 0) starts a new history.
         """
-        steps = int(sim.steps)
-        if steps == self._last_step and steps != 0:
-            return
-        if steps == 0 or steps < self._last_step:
-            self._value_steps, self._values, self._positions = [], [], []
-        self._last_step = steps
-        self._value_steps.append(steps)
-        self._values.append(float(sim.gathered_value))
-        keep = self._options.trail
-        if keep > 0:
-            self._positions.append(np.array(sim.world.robot_pos, dtype=float))
-            del self._positions[:-(keep + 1)]
+        self._history.record(sim, self._options.trail)
 
     # ------------------------------------------------------------------ drawing
     def draw(self, sim: GatheringSimulation) -> pygame.Surface:
@@ -225,7 +217,7 @@ class Renderer:
         self.record(sim)
         pg, surf = self._pg, self._surface
         size = self._options.size_px
-        self._view_for(sim)
+        self._set_view(*_view_window(self.config, self._options, sim))
         surf.fill(PAGE)
         surf.set_clip(pg.Rect(0, 0, size, size))
         draw_arena(self, surf)
@@ -234,131 +226,11 @@ class Renderer:
         draw_blocks(self, sim, surf)
         draw_robots(self, sim, surf)
         if self.render_mode == "human" and self._window is not None and not self.panel_px:
-            self._draw_keys(surf, 4, size - self._small.line - 4)
+            draw_keys(self, surf, 4, size - self._small.line - 4)
         surf.set_clip(None)
         if self.panel_px:
-            self._draw_panel(sim, surf)
+            self.sparkline_rect = draw_panel(self, sim, surf)
         return surf
-
-    # ------------------------------------------------------------------ panel
-    def _draw_panel(self, sim: GatheringSimulation, surf: pygame.Surface) -> None:
-        pg, text, small = self._pg, self._text, self._small
-        size, m = self._options.size_px, self._margin
-        x0 = size + m
-        width = self.panel_px - 2 * m
-        pg.draw.line(surf, (210, 210, 205), (size, 0), (size, size - 1))
-        y = m
-        cfg = self.config
-        text.draw(surf, f"step {sim.steps} / {cfg.max_cycles}", x0, y)
-        y += text.line
-        text.draw(surf, f"gathered value {sim.gathered_value:g} / {sim.total_value:g}", x0, y)
-        y += text.line
-        types = np.asarray(sim.world.block_type)
-        gathered = np.asarray(sim.gathered, dtype=bool)
-        sw = max(6, text.line - 6)
-        for t, name in enumerate(BLOCK_TYPE_NAMES):
-            total = int(np.sum(types == t))
-            if total == 0:
-                continue
-            done = int(np.sum(gathered & (types == t)))
-            pg.draw.rect(surf, BLOCK_COLOURS[t], pg.Rect(x0, y + (text.line - sw) // 2, sw, sw))
-            text.draw(surf, f"{name} {done} / {total}", x0 + sw + 4, y)
-            y += text.line
-        y += m // 2
-        # sparkline of the gathered value over the episode
-        spark_h = max(24, size // 10)
-        small.draw(surf, "gathered value over the episode", x0, y, MUTED)
-        y += small.line + 2
-        self.sparkline_rect = pg.Rect(x0, y, width, spark_h)
-        self._draw_sparkline(surf, self.sparkline_rect, sim.total_value)
-        y += spark_h + m
-        # morphology table
-        text.draw(surf, f"sensors ({len(sim.morphology)}, every robot)", x0, y)
-        y += text.line
-        y += text.draw_table(surf, sim.morphology, x0, y, max(6, text.width("00"))) + m // 2
-        # legend
-        y = self._draw_legend(surf, sim, x0, y, width) + m // 2
-        small.draw(surf, f"view {self._options.view}, cones {self._cones_label(sim)}"
-                   + (f", trail {self._options.trail}" if self._options.trail else ""), x0, y, MUTED)
-        y += small.line
-        if self.render_mode == "human" and self._window is not None:
-            self._draw_keys(surf, x0, max(y + 2, size - m - 2 * small.line), width)
-
-    def _cones_label(self, sim: GatheringSimulation) -> str:
-        robots = self.cone_robots(sim)
-        if robots.size == len(sim.world.robot_pos):
-            return "all"
-        if robots.size == 0:
-            return "none"
-        return "robot " + ",".join(str(i) for i in robots.tolist())
-
-    def _draw_sparkline(self, surf: pygame.Surface, box: pygame.Rect, total: float) -> None:
-        pg = self._pg
-        pg.draw.rect(surf, (255, 255, 255), box)
-        pg.draw.rect(surf, (200, 200, 195), box, 1)
-        if not self._values:
-            return
-        steps = np.asarray(self._value_steps, dtype=float)
-        values = np.asarray(self._values, dtype=float)
-        x_max = max(float(self.config.max_cycles), 1.0)
-        cols = np.arange(box.width - 2)
-        at = cols / max(box.width - 3, 1) * x_max
-        at = at[at <= steps[-1]]
-        idx = np.searchsorted(steps, at, side="right") - 1
-        v = values[np.maximum(idx, 0)] / max(total, 1e-12)
-        xs = box.left + 1 + np.arange(len(at))
-        ys = box.bottom - 2 - v * (box.height - 4)
-        pts = np.stack([xs, ys], axis=1).tolist()
-        if len(pts) >= 2:
-            pg.draw.lines(surf, ZONE_EDGE, False, pts, 2)
-        elif pts:
-            pg.draw.circle(surf, ZONE_EDGE, pts[0], 2)
-
-    def _draw_legend(self, surf: pygame.Surface, sim: GatheringSimulation, x0: int, y: int, width: int) -> int:
-        """Swatches with names, wrapped to the panel width; returns the y below them."""
-        pg, small = self._pg, self._small
-        h = max(small.line, 10)
-        sw = max(6, h - 4)
-        kinds = sorted({c[0] for c in cone_sensors(sim.morphology)}, key=_CONE_ORDER.index)
-        items: list[tuple[str, str, RGB, RGB | None]] = [
-            ("gathered", "box", tuple(int(v * GATHERED_SHADE) for v in BLOCK_COLOURS[1]), GATHERED_EDGE),
-            ("carried", "box", BLOCK_COLOURS[1], ROBOT_ATTACHED),
-            ("robot", "disc", ROBOT, None),
-            ("attached", "disc", ROBOT_ATTACHED, None),
-        ]
-        if self._options.trail:
-            items.append(("trail", "line", TRAIL, None))
-        items += [(kind, "box", cone_colour_on(FLOOR, kind), SENSOR_COLOURS[kind]) for kind in kinds]
-        x = x0
-        for name, shape, fill, edge in items:
-            need = sw + 3 + small.width(name) + 10
-            if x > x0 and x + need > x0 + width:
-                x, y = x0, y + h
-            top = y + (h - sw) // 2
-            if shape == "disc":
-                pg.draw.circle(surf, fill, (x + sw // 2, top + sw // 2), sw // 2)
-                pg.draw.line(surf, HEADING, (x + sw // 2 + 1, top + sw // 2), (x + sw - 1, top + sw // 2))
-            elif shape == "line":
-                pg.draw.line(surf, fill, (x, top + sw // 2), (x + sw, top + sw // 2), 2)
-            else:
-                box = pg.Rect(x, top, sw, sw)
-                pg.draw.rect(surf, fill, box)
-                pg.draw.rect(surf, edge, box, 2 if name == "carried" else 1)
-            small.draw(surf, name, x + sw + 3, y)
-            x += need
-        return y + h
-
-    def _draw_keys(self, surf: pygame.Surface, x: int, y: int, width: int | None = None) -> None:
-        small = self._small
-        state = "PAUSED   " if self.paused else ""
-        line = f"{state}{KEYS}   ({self.fps:g} fps)"
-        if width is not None and small.width(line) > width:      # two lines in a narrow panel
-            parts = KEYS.split("   ")
-            half = (len(parts) + 1) // 2
-            small.draw(surf, state + "   ".join(parts[:half]), x, y, MUTED)
-            small.draw(surf, "   ".join(parts[half:]) + f"   ({self.fps:g} fps)", x, y + small.line, MUTED)
-        else:
-            small.draw(surf, line, x, y, MUTED)
 
     # ------------------------------------------------------------------ output
     def render(self, sim: GatheringSimulation, **options: Any) -> np.ndarray | None:
@@ -377,57 +249,8 @@ class Renderer:
                 self._configure(saved)
         if self.render_mode == "rgb_array":
             return _surface_to_array(self._pg, self.draw(sim))
-        self._show(sim)
+        show(self, sim)
         return None
-
-    def _show(self, sim: GatheringSimulation) -> None:
-        """``"human"``: show the frame, handle keys; while paused, wait for keys here."""
-        pg = self._pg
-        if self._window is None:
-            try:
-                pg.display.init()
-                self._window = pg.display.set_mode(self._surface.get_size())
-            except pg.error as err:
-                raise RuntimeError(
-                    f"render_mode='human' could not open a window ({err}); "
-                    "use render_mode='rgb_array' without a display"
-                ) from None
-            pg.display.set_caption("collective gathering   " + KEYS)
-            self._clock = pg.time.Clock()
-        step = self._handle_events(pg.event.get())
-        while self._window is not None:
-            if self._window.get_size() != self._surface.get_size():
-                self._window = pg.display.set_mode(self._surface.get_size())
-            self._window.blit(self.draw(sim), (0, 0))
-            pg.display.flip()
-            if not self.paused:
-                self._clock.tick(self.fps)
-                return
-            if step:
-                return
-            step = self._handle_events([pg.event.wait(200)])
-
-    def _handle_events(self, events: Sequence[Any]) -> bool:
-        """Apply window events; True if a single step was asked for (or the window closed)."""
-        pg = self._pg
-        step = False
-        for event in events:
-            if event.type == pg.QUIT or (event.type == pg.KEYDOWN and event.key in (pg.K_ESCAPE, pg.K_q)):
-                self.close()
-                return True
-            if event.type != pg.KEYDOWN:
-                continue
-            if event.key == pg.K_SPACE:
-                self.paused = not self.paused
-            elif event.key in (pg.K_RIGHT, pg.K_PERIOD):
-                step = True
-            elif event.key in (pg.K_PLUS, pg.K_EQUALS, pg.K_KP_PLUS, pg.K_UP):
-                self.fps = min(self.fps * 2.0, 960.0)
-            elif event.key in (pg.K_MINUS, pg.K_KP_MINUS, pg.K_DOWN):
-                self.fps = max(self.fps / 2.0, 0.5)
-            elif event.key == pg.K_c:
-                self._cone_toggle = (self._cone_toggle + 1) % 3
-        return step
 
     def close(self) -> None:
         """Close the ``"human"`` window if one is open (safe to call more than once)."""
