@@ -44,6 +44,16 @@ World y points up (north); screen y points down. ``Renderer.to_screen`` maps wor
 frame pixels. pygame is imported lazily by ``Renderer`` so importing ``gathering_env`` does not
 need it; ``"rgb_array"`` draws offscreen and never opens a window. The ``"human"`` window has
 keys (listed in the window): space pause, right arrow step, +/- faster/slower, c cones, esc close.
+
+Modules (every public name is re-exported here; import from ``gathering_env.render``):
+
+``options``   ``RenderOptions``, ``RenderOptionError``, ``parse_cones``/``parse_view``, option bounds.
+``renderer``  ``Renderer``: options, the view (world -> pixels), the recorded history, render/close.
+``drawing``   colours, cone geometry, text and table helpers, the arena/trail/cone/block/robot layers.
+``panel``     the information panel: counts, sparkline, morphology table, legend, ``KEYS``.
+``window``    the ``"human"`` window: showing frames, the keys.
+``figures``   ``film_strip``, ``sensor_layout``.
+``export``    ``save_png``, ``save_video``.
 """
 
 from .drawing import (
