@@ -1,42 +1,58 @@
-# make test   : create .venv if missing, install the project with its test extras, run the fast tests
-# make demo   : set up and run the main job
-# make bench  : print the environment and generation benchmarks
+# make demo        : create .venv if missing, install the core (no torch, no Ray), run the main job
+# make test        : ... install the test extras, run the fast tests (RL and Ray tests skip)
+# make test-slow   : ... install every extra (RL, Ray, video), run the slow tests (CI runs both)
+# make bench       : print the environment and generation benchmarks
+# make docs-images : regenerate every figure of docs/ (examples/docs_images.py)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
-STAMP  := $(VENV)/.installed
+# one stamp per install level; each level installs the one below it too
+CORE   := $(VENV)/.installed-core
+TESTS  := $(VENV)/.installed-test
+ALL    := $(VENV)/.installed-all
+PIP    := $(PY) -m pip install --quiet --disable-pip-version-check
 
-.PHONY: test test-slow demo bench lint clean
+.PHONY: test test-slow demo bench lint docs-images clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
 
-$(STAMP): pyproject.toml | $(PY)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[dev,video,ray,rl]"
-	touch $(STAMP)
+$(CORE): pyproject.toml | $(PY)
+	$(PIP) -e .
+	touch $(CORE)
 
-test: $(STAMP)
+$(TESTS): pyproject.toml | $(PY)
+	$(PIP) -e ".[dev]"
+	touch $(CORE) $(TESTS)
+
+$(ALL): pyproject.toml | $(PY)
+	$(PIP) -e ".[dev,video,ray,rl]"
+	touch $(CORE) $(TESTS) $(ALL)
+
+test: $(TESTS)
 	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy $(PY) -m pytest -q
 
-test-slow: $(STAMP)
+test-slow: $(ALL)
 	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy $(PY) -m pytest -q -m slow; rc=$$?; \
 	  if [ $$rc -eq 5 ]; then echo "no slow tests"; exit 0; else exit $$rc; fi
 
 # The main job on built-in defaults: a short HyperNEAT-M run (configs/quick.toml), its
 # statistics plot, and a replay GIF of the champion team. out/quick is recreated each time.
-demo: $(STAMP)
+demo: $(CORE)
 	rm -rf out/quick
 	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy $(VENV)/bin/gathering-evolve configs/quick.toml --out out/quick
 	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy $(VENV)/bin/gathering-replay out/quick/champion.json --out out/quick/team.gif
 	@echo "plot: out/quick/stats.png   replay: out/quick/team.gif   champion: out/quick/champion.json"
 
-bench: $(STAMP)
+bench: $(CORE)
 	$(PY) benchmarks/bench_env.py
 	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_generation.py
 
-lint: $(STAMP)
+lint: $(TESTS)
 	$(PY) -m ruff check .
+
+docs-images: $(CORE)
+	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy $(PY) examples/docs_images.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache
