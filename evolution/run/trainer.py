@@ -35,6 +35,7 @@ from evolution.run.evaluate import Evaluation
 from evolution.run.experiment import Experiment
 from evolution.run.recorder import RunRecorder, convergence_target
 from evolution.run.rundir import new_run, restore_run
+from gathering_env.compiled.engine import announce_compile
 
 
 @dataclass
@@ -129,6 +130,8 @@ class Trainer:
         # Starting a backend (Ray in particular) may draw from Python's global random generator,
         # which is neat-python's: keep the lineage independent of the backend.
         random_state = random.getstate()
+        if dict(exp.environment).get("kernel", "compiled") == "compiled":
+            announce_compile()  # here, once: not from every worker, nor across the progress bar
         evaluator = self._evaluator = make_evaluator(context, self.workers, self.backend, self.ray_address,
                                                      self.max_retries)
         random.setstate(random_state)
