@@ -237,7 +237,7 @@ def analyze_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--backend", choices=BACKENDS, default="process",
                         help="where --reevaluate runs (default: process pool)")
     args = parser.parse_args(argv)
-    from evolution.analysis.fronts import analyse
+    from evolution.analysis.fronts import analyse, nothing_to_compare
     from evolution.analysis.report import REPORT_FILES, write_report
     from evolution.guard import check_output_dir
 
@@ -245,6 +245,9 @@ def analyze_main(argv: list[str] | None = None) -> int:
     analysis = analyse(args.runs, reevaluate=args.reevaluate, workers=args.workers, backend=args.backend)
     path = write_report(analysis, args.out)
     print(f"{len(analysis.runs)} runs, {len(analysis.comparisons)} comparisons -> {path}")
+    untested = sorted({c.untested for c in analysis.comparisons if c.untested})
+    for line in filter(None, [nothing_to_compare(analysis), *untested]):
+        print(line)
     print(f"ft used: {analysis.scores}")
     return 0
 
