@@ -1,14 +1,14 @@
 # make demo        : create .venv if missing, install the core (no torch, no Ray), run the main job
-# make test        : ... install the test extras, run the fast tests (RL and Ray tests skip)
-# make test-slow   : ... install every extra (RL, Ray, video), run the slow tests (CI runs both)
+# make test        : ... install everything the tests import (test extras + RL, Ray, video), run the fast tests
+# make test-slow   : ... the same install, run the slow tests (CI runs make test, then make test-slow)
+# (With only ".[dev]" installed the RL, Ray and MP4 tests skip; everything else runs.)
 # make bench       : print the environment and generation benchmarks
 # make docs-images : regenerate every figure of docs/ (examples/docs_images.py)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
-# one stamp per install level; each level installs the one below it too
+# one stamp per install level; the full level includes the core
 CORE   := $(VENV)/.installed-core
-TESTS  := $(VENV)/.installed-test
 ALL    := $(VENV)/.installed-all
 PIP    := $(PY) -m pip install --quiet --disable-pip-version-check
 
@@ -21,15 +21,11 @@ $(CORE): pyproject.toml | $(PY)
 	$(PIP) -e .
 	touch $(CORE)
 
-$(TESTS): pyproject.toml | $(PY)
-	$(PIP) -e ".[dev]"
-	touch $(CORE) $(TESTS)
-
 $(ALL): pyproject.toml | $(PY)
 	$(PIP) -e ".[dev,video,ray,rl]"
-	touch $(CORE) $(TESTS) $(ALL)
+	touch $(CORE) $(ALL)
 
-test: $(TESTS)
+test: $(ALL)
 	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy $(PY) -m pytest -q
 
 test-slow: $(ALL)
@@ -48,7 +44,7 @@ bench: $(CORE)
 	$(PY) benchmarks/bench_env.py
 	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_generation.py
 
-lint: $(TESTS)
+lint: $(ALL)
 	$(PY) -m ruff check .
 
 docs-images: $(CORE)
