@@ -113,3 +113,39 @@ def test_sdist_holds_the_project_and_runs_its_tests(tmp_path):
                             "print(gathering_env.__file__); print(e.CONFIG_DIR)"],
                            cwd=top, env=env, capture_output=True, text=True, check=True).stdout.split()
     assert where == [str(top / "gathering_env" / "__init__.py"), str(top / "configs")]
+
+
+def code_map_paths(readme: str) -> set[str]:
+    """Paths named by the README's code map (a tree: two spaces per level, folders end in /)."""
+    block = readme.split("## Code map", 1)[1].split("```", 2)[1]
+    stack: list[tuple[int, str]] = []
+    named = set()
+    for line in block.splitlines():
+        if not line.strip():
+            continue
+        indent = len(line) - len(line.lstrip(" "))
+        name = line.split()[0]
+        while stack and stack[-1][0] >= indent:
+            stack.pop()
+        path = "".join(folder for _, folder in stack) + name
+        named.add(path.rstrip("/"))
+        if name.endswith("/"):
+            stack.append((indent, name))
+    return named
+
+
+def test_code_map_parser_rebuilds_nested_paths():
+    text = "## Code map\n\n```\npkg/   a\n  sub/   b\n    m.py   c\n  rl/sb3.py   d\ntop.py   e\n```\n"
+    assert code_map_paths(text) == {"pkg", "pkg/sub", "pkg/sub/m.py", "pkg/rl/sb3.py", "top.py"}
+
+
+def test_readme_code_map_names_every_module():
+    named = code_map_paths((ROOT / "README.md").read_text(encoding="utf-8"))
+    modules = {p.relative_to(ROOT).as_posix() for package in ("gathering_env", "evolution")
+               for p in (ROOT / package).rglob("*.py") if "__pycache__" not in p.parts}
+    # a subpackage's __init__.py is named by its folder, or by a module under it (rl/sb3.py)
+    folders = {n.rsplit("/", 1)[0] for n in named if "/" in n} | named
+    missing = sorted(m for m in modules if m not in named and not (m.endswith("/__init__.py")
+                                                                   and m.rsplit("/", 1)[0] in folders))
+    assert missing == []
+    assert sorted(n for n in named if n.endswith(".py") and n not in modules) == []  # no stale names
