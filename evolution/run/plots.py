@@ -12,7 +12,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-
 # Axis limits with a margin, so a curve at a bound (ten sensors, C = 100, ft = 0) stays visible
 # instead of hiding on the frame; C and the sensor count share the right panel's grid lines.
 C_LIMITS = (-3.0, 103.0)

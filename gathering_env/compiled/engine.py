@@ -29,7 +29,6 @@ from ..sensors import Morphology
 from ..world import STATE_ARRAYS, GatheringWorld
 from . import kernels
 
-
 COMPILE_SECONDS = 10
 """About how long the first compile of the kernels takes on one core of a 2-core machine
 (measured 7-9 s; once per installation, numba caches the machine code on disk)."""
