@@ -1,9 +1,10 @@
-# make demo        : create .venv if missing, install the core (no torch, no Ray), run the main job
-# make test        : ... install everything the tests import (test extras + RL, Ray, video), run the fast tests
-# make test-slow   : ... the same install, run the slow tests (CI runs make test, then make test-slow)
+# make demo           : create .venv if missing, install the core (no torch, no Ray), run the main job
+# make test           : ... install everything the tests import (test extras + RL, Ray, video), run the fast tests
+# make test-slow      : ... the same install, run the slow tests (CI runs make test, then make test-slow)
 # (With only ".[dev]" installed the RL, Ray and MP4 tests skip; everything else runs.)
-# make bench       : print the environment and generation benchmarks
-# make docs-images : regenerate every figure of docs/ (examples/docs_images.py)
+# make bench          : print the environment and generation benchmarks
+# make bench-learning : the learning benchmark (S1 and M1 at a mid budget, held-out comparison)
+# make docs-images    : regenerate every figure of docs/ (examples/docs_images.py)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -12,7 +13,7 @@ CORE   := $(VENV)/.installed-core
 ALL    := $(VENV)/.installed-all
 PIP    := $(PY) -m pip install --quiet --disable-pip-version-check
 
-.PHONY: test test-slow demo bench lint docs-images clean
+.PHONY: test test-slow demo bench bench-learning lint docs-images clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -43,6 +44,12 @@ demo: $(CORE)
 bench: $(CORE)
 	$(PY) benchmarks/bench_env.py
 	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_generation.py
+
+# Does evolution learn? S1 and M1 at a mid budget (about an hour on 2 idle cores), then the
+# champions against scripted teams on held-out layouts (docs/evidence.md). Resumable:
+# make bench-learning ARGS=--resume
+bench-learning: $(CORE)
+	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_learning.py --out runs/bench-learning $(ARGS)
 
 lint: $(ALL)
 	$(PY) -m ruff check .

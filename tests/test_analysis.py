@@ -139,7 +139,9 @@ def test_stats_figure_keeps_curves_off_the_frame_and_the_band_above_zero():
     records = [{"generation": g, "task_best": 5.0 + g, "task_mean": 1.0, "task_std": 4.0,
                 "morphology_mean": 100.0, "num_sensors_mean": 10.0} for g in range(4)]
     fig = run_figure(records)
-    ax1, ax2, twin = fig.axes
+    by_label = {ax.get_ylabel(): ax for ax in fig.axes}
+    ax1, ax2 = by_label["task performance ft (eq. 1)"], by_label["morphological simplicity C (eq. 2)"]
+    twin = by_label["sensors per robot"]
     assert twin.get_ylim()[1] > 10.0 and twin.get_ylim()[0] < 0.0     # ten sensors: not on the top border
     assert ax2.get_ylim()[1] > 100.0 and ax2.get_ylim()[0] < 0.0       # C = 100 likewise
     (band,) = ax1.collections
