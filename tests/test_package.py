@@ -30,7 +30,7 @@ NOT_SOURCE_SUFFIXES = (".pyc", ".egg-info")
 # small_runs' shared run directories (reevaluate), the shipped presets (presets).
 SUBSET = ["tests/test_scoring.py", "tests/test_reevaluate.py", "tests/test_presets.py"]
 # References a reader of this repository cannot follow.
-OUTSIDE = re.compile(r"\.\./shared|\bSPEC\b|\b[Ii]ssue \d+|\(issue\b")
+OUTSIDE = re.compile(r"/work/|\.\./shared|\bSPEC\b|\b[Ii]ssue \d+|\(issue\b")
 TEXT_SUFFIXES = {".py", ".md", ".toml", ".cfg", ".cff", ".txt", ".in", ".yml", ".yaml", ""}
 
 
