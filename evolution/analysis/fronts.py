@@ -185,7 +185,8 @@ class Comparison:
         if self.n_so < 2 or self.n_mo < 2:
             return f"too few runs for a test (SO {self.n_so}, MO {self.n_mo}; a t-test needs 2 of each)"
         if math.isnan(self.p_value):
-            return "no variation in either sample: no test"
+            return (f"no variation (every SO run {self.so_mean:.2f}, every MO run {self.mo_mean:.2f}): "
+                    "no test")
         return None
 
 
