@@ -49,6 +49,9 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
     except Exception as err:  # neat raises several error types for broken files
         raise ExperimentError(f"{path}: invalid neat-python config: {err}") from None
     check_neat_config(config, path)
+    if not experiment.multi_objective:
+        # the experiment's elitism: "ratchet" carries the best-ever genome, unscored (NEATReproduction)
+        config.reproduction_config.ratchet = experiment.elitism == "ratchet"
     config.pop_size = experiment.population
     config.no_fitness_termination = True  # the trainer decides when to stop
     return config
