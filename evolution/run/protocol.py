@@ -18,9 +18,11 @@ key                           paper (default)     original
 ``[experiment] speciation``   ``"adaptive"``      ``"original"``: Encog's distance and threshold
 ``[environment] zone_depth``  8                   4 (zone 20 x 4)
 ``[environment] pickup_box``  ``"front"``         ``"centre"``, 0.1 forward x 0.2 across
+``[environment] ir_response`` ``"linear"``        ``"gamma"`` (the Khepera-like curve)
 ``[substrate] decode_window`` 1                   0.2 (middle 20 % of range, FOV, orientation)
 ``[substrate] sensor_types``  IR, US, colour,     IR, US, camera, colour (the type bands' order)
                               camera
+``[substrate] bias_threshold`` false              true (biases thresholded like link weights)
 ============================  ==================  ================================================
 
 (The time bonus 20 and the 5 trials of 10 000 steps are the paper's and the 2018 code's alike.)
@@ -38,8 +40,10 @@ from typing import Any
 #: dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``).
 ORIGINAL: dict[str, dict[str, Any]] = {
     "experiment": {"layout": "per_run", "elitism": "ratchet", "complexity": "original"},
-    "environment": {"zone_depth": 4.0, "pickup_box": "centre", "pickup_box_width": 0.2, "pickup_box_depth": 0.1},
-    "substrate": {"decode_window": 0.2, "sensor_types": ["infrared", "ultrasonic", "camera", "colour"]},
+    "environment": {"zone_depth": 4.0, "pickup_box": "centre", "pickup_box_width": 0.2, "pickup_box_depth": 0.1,
+                    "ir_response": "gamma"},
+    "substrate": {"decode_window": 0.2, "sensor_types": ["infrared", "ultrasonic", "camera", "colour"],
+                  "bias_threshold": True},
 }
 
 PROTOCOLS = ("paper", "original")
