@@ -56,10 +56,11 @@ def test_the_protocol_sets_every_original_option(tmp_path):
     assert (world.zone_depth, world.pickup_box, world.pickup_box_width, world.pickup_box_depth) == (4.0, "centre",
                                                                                                     0.2, 0.1)
     assert exp.substrate["decode_window"] == 0.2
-    assert exp.substrate["sensor_types"] == ["infrared", "ultrasonic", "camera", "colour"]
+    assert exp.substrate["bias_threshold"] is True and exp.speciation == "original"
     # without the key every option keeps the paper's default ...
     plain = load_experiment(experiment(tmp_path, "plain", body=""))
-    assert (plain.layout, plain.elitism, plain.complexity, plain.protocol) == ("per_trial", "species", "paper", None)
+    assert (plain.layout, plain.elitism, plain.complexity, plain.protocol, plain.speciation) == (
+        "per_trial", "species", "paper", None, None)
     assert (plain.world_config().zone_depth, plain.world_config().pickup_box) == (8.0, "front")
     # ... "paper" names those defaults, and each option can be set on its own
     assert protocol_values("paper")["environment"]["zone_depth"] == 8.0
@@ -374,3 +375,16 @@ def test_a_run_records_the_original_complexity(tmp_path):
     morph = Morphology.from_dict({"sensors": champion["morphology"]} if isinstance(champion["morphology"], list)
                                  else champion["morphology"])
     assert champion["objectives"]["morphology"] == pytest.approx(morphological_complexity(morph, "original"))
+
+
+def test_spawn_counts_reach_the_offspring_places_exactly():
+    """With the ratchet N - 1 places are left; neat-python's adjustment alone gives up on this one."""
+    import neat
+
+    from evolution.reproduction.breeding import NEATReproduction
+
+    with pytest.raises(RuntimeError, match="could not match"):
+        neat.DefaultReproduction._adjust_spawn_exact(None, [3, 2, 1, 1, 1, 1, 1], 7, 1)
+    repro = NEATReproduction.__new__(NEATReproduction)
+    assert repro._exact_spawn([3, 2, 1, 1, 1, 1, 1], 7, 1) == [1] * 7
+    assert repro._exact_spawn([1, 1, 1], 6, 1) == [2, 2, 2]

@@ -236,6 +236,18 @@ class NEATReproduction(neat.DefaultReproduction):
         return DefaultClassConfig(param_dict, [ConfigParameter("elitism", int, 0),
                                                ConfigParameter("min_species_size", int, 1)], cls.__name__)
 
+    def _exact_spawn(self, spawn: list[int], total: int, min_size: int) -> list[int]:
+        """neat-python's ``_adjust_spawn_exact``, repeated: it gives up after one pass over the
+        species even when a further pass could still take genomes from species above the minimum
+        (and raises), but it changes ``spawn`` in place, so each call gets closer."""
+        for _ in range(total + len(spawn)):
+            try:
+                return self._adjust_spawn_exact(spawn, total, min_size)
+            except RuntimeError as err:
+                if "Internal error" not in str(err):
+                    raise
+        return self._adjust_spawn_exact(spawn, total, min_size)
+
     def reproduce(self, config: Any, species: Any, pop_size: int, generation: int) -> dict[int, Any]:
         config.genome_config.innovation_tracker = self.innovation_tracker
         self.innovation_tracker.reset_generation()
@@ -264,9 +276,15 @@ class NEATReproduction(neat.DefaultReproduction):
         elitism = 0 if ratchet else cfg.elitism
         offspring = pop_size - 1 if ratchet else pop_size
         min_size = max(cfg.min_species_size, elitism)
+        if len(remaining) * min_size > offspring:
+            # more species than offspring places (the original's speciation can form many): the
+            # species with the lowest adjusted fitness get none and die out (Encog's levelOff)
+            ranked_species = sorted(remaining, key=lambda s: (s.adjusted_fitness, -s.key), reverse=True)
+            kept = {s.key for s in ranked_species[:max(offspring // min_size, 1)]}
+            remaining = [s for s in remaining if s.key in kept]
         spawn = self.compute_spawn([s.adjusted_fitness for s in remaining], [len(s.members) for s in remaining],
                                    offspring, min_size)
-        spawn = self._adjust_spawn_exact(spawn, offspring, min_size)
+        spawn = self._exact_spawn(spawn, offspring, min_size)
 
         new_population: dict[int, Any] = {}
         if ratchet:

@@ -15,17 +15,17 @@ key                           paper (default)     original
 ``[experiment] elitism``      ``"species"``       ``"ratchet"``: only the best-ever genome is
                                                   carried over, unchanged and never re-scored
 ``[experiment] complexity``   ``"paper"``         ``"original"``: eq. 2 as the code computed it
-``[experiment] speciation``   ``"adaptive"``      ``"original"``: Encog's distance and threshold
+``[experiment] speciation``   (the neat config's  ``"original"``: Encog's distance and threshold
+                              ``species_mode``)   rule (``evolution.reproduction.species``)
 ``[environment] zone_depth``  8                   4 (zone 20 x 4)
 ``[environment] pickup_box``  ``"front"``         ``"centre"``, 0.1 forward x 0.2 across
 ``[environment] ir_response`` ``"linear"``        ``"gamma"`` (the Khepera-like curve)
 ``[substrate] decode_window`` 1                   0.2 (middle 20 % of range, FOV, orientation)
-``[substrate] sensor_types``  IR, US, colour,     IR, US, camera, colour (the type bands' order)
-                              camera
 ``[substrate] bias_threshold`` false              true (biases thresholded like link weights)
 ============================  ==================  ================================================
 
-(The time bonus 20 and the 5 trials of 10 000 steps are the paper's and the 2018 code's alike.)
+(The time bonus 20, the 5 trials of 10 000 steps, the sensor-type bands' order and the weld that
+seats the robot are the paper's and the 2018 code's alike, so they are not in the bundle.)
 
 ``protocol = "paper"`` names the defaults. A file that names a protocol and sets one of its
 keys to another value is refused (``ExperimentError`` naming the file and key); without a
@@ -39,11 +39,10 @@ from typing import Any
 #: Protocol name -> {section: {key: value}}; the "paper" values are the defaults of the
 #: dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``).
 ORIGINAL: dict[str, dict[str, Any]] = {
-    "experiment": {"layout": "per_run", "elitism": "ratchet", "complexity": "original"},
+    "experiment": {"layout": "per_run", "elitism": "ratchet", "complexity": "original", "speciation": "original"},
     "environment": {"zone_depth": 4.0, "pickup_box": "centre", "pickup_box_width": 0.2, "pickup_box_depth": 0.1,
                     "ir_response": "gamma"},
-    "substrate": {"decode_window": 0.2, "sensor_types": ["infrared", "ultrasonic", "camera", "colour"],
-                  "bias_threshold": True},
+    "substrate": {"decode_window": 0.2, "bias_threshold": True},
 }
 
 PROTOCOLS = ("paper", "original")
@@ -97,6 +96,11 @@ def apply_protocol(name: str, sections: dict[str, dict[str, Any]], source: str,
             continue
         target = sections[section]
         for key, value in keys.items():
+            if value is None:  # the paper's "speciation": whatever the neat config says
+                if target.get(key) is not None:
+                    raise ValueError(f"{source}: [{section}] {key} = {target[key]!r} contradicts protocol = "
+                                     f"{name!r}; allowed: no {key} key (the neat config's own)")
+                continue
             if key in target and not _same(target[key], value):
                 raise ValueError(f"{source}: [{section}] {key} = {target[key]!r} contradicts protocol = {name!r}; "
                                  f"allowed: {value!r} (or no protocol key, to set it on its own)")
