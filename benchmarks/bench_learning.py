@@ -2,7 +2,7 @@
 on the same held-out layouts.
 
     python benchmarks/bench_learning.py [--out runs/bench-learning] [--workers 2] [--resume]
-        [--population 150] [--trials 2] [--steps 4000] [--generations 40] [--seed 7]
+        [--population 150] [--trials 2] [--steps 3000] [--generations 40] [--seed 7]
         [--heldout 20] [--heldout-steps 10000]
 
 (``make bench-learning``.) Evolves the ``S1`` and ``M1`` presets (environment 1, HyperNEAT-M;
@@ -58,7 +58,7 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--resume", action="store_true", help="continue the runs in OUT (after a kill)")
     p.add_argument("--population", type=int_arg(2, 10_000), default=150)
     p.add_argument("--trials", type=int_arg(1, 100), default=2)
-    p.add_argument("--steps", type=int_arg(10, 100_000), default=4000)
+    p.add_argument("--steps", type=int_arg(10, 100_000), default=3000)
     p.add_argument("--generations", type=int_arg(1, 10_000), default=40)
     p.add_argument("--seed", type=int_arg(0, 2**31), default=7)
     p.add_argument("--heldout", type=int_arg(2, 1000), default=20)
