@@ -82,7 +82,8 @@ def _species_modes() -> tuple[str, ...]:
 
 
 #: Keys whose value is one of a few names.
-CHOICES = {"method": lambda: METHODS, "speciation": _species_modes}
+CHOICES = {"method": lambda: METHODS, "speciation": _species_modes, "protocol": lambda: PROTOCOLS,
+           "layout": lambda: LAYOUTS, "elitism": lambda: ELITISM, "complexity": lambda: COMPLEXITY_FORMULAS}
 
 
 class ExperimentError(ValueError):
@@ -315,9 +316,7 @@ def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str,
     if exp_section.get("protocol", "") is None:
         del exp_section["protocol"]  # a saved experiment without a protocol
     if "protocol" in exp_section:
-        if exp_section["protocol"] not in PROTOCOLS:
-            raise ExperimentError(f"{source}: [experiment] protocol={exp_section['protocol']!r}; "
-                                  f"allowed: {list(PROTOCOLS)}")
+        _check_key(source, "protocol", exp_section["protocol"])  # before its bundle is applied
         try:
             apply_protocol(exp_section["protocol"], {"experiment": exp_section, "environment": env_section,
                                                      "substrate": sub_section},
@@ -381,12 +380,6 @@ def _check_key(source: str, key: str, value: Any) -> Any:
         if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
             allowed = f">= {low}" if high == math.inf else f"in [{low}, {high}]"
             raise ExperimentError(f"{where}={value!r}; allowed: an integer {allowed}")
-        return value
-    choices = {"protocol": PROTOCOLS, "layout": LAYOUTS, "elitism": ELITISM,
-               "complexity": COMPLEXITY_FORMULAS}
-    if key in choices:
-        if value not in choices[key]:
-            raise ExperimentError(f"{where}={value!r}; allowed: {list(choices[key])}")
         return value
     if key == "convergence_stop":
         if not isinstance(value, bool):
