@@ -92,8 +92,11 @@ def _load_cache(path: Path) -> dict[str, Any]:
 
 
 def _entry_key(genome: dict[str, Any], experiment: Any, seeds: list[int]) -> str:
-    blob = json.dumps({"genome": genome, "method": experiment.method, "environment": experiment.environment,
-                       "substrate": experiment.substrate, "seeds": seeds}, sort_keys=True)
+    entry = {"genome": genome, "method": experiment.method, "environment": experiment.environment,
+             "substrate": experiment.substrate, "seeds": seeds}
+    if experiment.complexity != "paper":  # (keys of earlier caches stay valid)
+        entry["complexity"] = experiment.complexity
+    blob = json.dumps(entry, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:24]
 
 
@@ -138,8 +141,9 @@ def reevaluate_run(run_dir: Path, trials: int, workers: int | None = None, backe
         else:
             todo.append((name, key, genome))
     if todo:
+        # fresh layouts whatever the run's layout; C by the run's own formula
         context = EvalContext(config, dict(experiment.environment), trials, experiment.seed, experiment.method,
-                              substrate)
+                              substrate, complexity=experiment.complexity)
         evaluator = make_evaluator(context, workers, backend)
         try:
             evaluations = evaluator.map([g for _, _, g in todo], tag)

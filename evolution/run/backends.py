@@ -40,10 +40,13 @@ class EvalContext:
     method: str
     substrate: Any = None
     extra: dict[str, Any] = field(default_factory=dict)
+    layout: str = "per_trial"
+    complexity: str = "paper"
 
     def evaluate(self, genome: Any, generation: int) -> Evaluation:
         return evaluate(genome, self.neat_config, self.env_config, trials=self.trials, seed=self.seed,
-                        generation=generation, method=self.method, substrate=self.substrate)
+                        generation=generation, method=self.method, substrate=self.substrate,
+                        layout=self.layout, complexity=self.complexity)
 
 
 class Evaluator(Protocol):

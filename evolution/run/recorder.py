@@ -145,7 +145,7 @@ class RunRecorder:
             genome = reproduction.parents.get(key) or reproduction.front_genomes[key]
             controller, morphology = decode_genome(exp.method, genome, self.config, self.substrate)
             values = dict(zip(exp.objectives, objectives))
-            values.setdefault("morphology", morphology_simplicity(morphology))
+            values.setdefault("morphology", morphology_simplicity(morphology, exp.complexity))
             values.setdefault("controller", 100.0 - float(controller.num_links))
             save_champion(front_dir / f"genome-{key}.json", method=exp.method, experiment=exp.name,
                           generation=generation, genome=genome, morphology=morphology,

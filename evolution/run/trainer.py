@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import random
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +46,20 @@ class RunResult:
     converged: bool
     interrupted: bool = False
     already_finished: bool = False
+
+
+def protocol_notes(exp: Experiment) -> list[str]:
+    """What a run does differently from the paper's defaults, one line each (printed at its start)."""
+    notes = []
+    if exp.protocol is not None:
+        notes.append(f"{exp.name}: protocol {exp.protocol!r}")
+    if exp.layout == "per_run":
+        notes.append(f"{exp.name}: one layout for the whole run (layout = per_run): its {exp.trials} trials would be "
+                     "the same episode in this deterministic simulator, so each genome runs it once")
+    if exp.elitism == "ratchet" and not exp.multi_objective:
+        notes.append(f"{exp.name}: ratchet (elitism = ratchet): the best-ever genome is carried over with its "
+                     "stored score and not evaluated again; only offspring are scored")
+    return notes
 
 
 class RunFailed(UsageError):
@@ -125,7 +139,9 @@ class Trainer:
             return self._result(recorder.converged(), already_finished=True)
         converged = False
         context = EvalContext(recorder.config, dict(exp.environment), exp.trials, exp.seed, exp.method,
-                              recorder.substrate)
+                              recorder.substrate, layout=exp.layout, complexity=exp.complexity)
+        for line in protocol_notes(exp):
+            print(line, flush=True)
         # Starting a backend (Ray in particular) may draw from Python's global random generator,
         # which is neat-python's: keep the lineage independent of the backend.
         random_state = random.getstate()
@@ -153,6 +169,7 @@ class Trainer:
                 threshold = history[-1][1] if history else population.species.species_set_config.compatibility_threshold
 
                 self._generation = generation
+                self._population = population
                 population.run(self._fitness, 1)
                 record = recorder.record(population, generation, species_count, time.perf_counter() - start,
                                          self._current, self._current_genomes, self._failures, threshold)
@@ -213,7 +230,16 @@ class Trainer:
             signal.signal(sig, handler)
 
     def _fitness(self, genomes: list[tuple[int, Any]], config: neat.Config) -> None:
-        """neat-python fitness function: evaluate on the backend, set fitness and objectives."""
+        """neat-python fitness function: evaluate on the backend, set fitness and objectives.
+
+        A genome the reproduction carried over unscored (``elitism = "ratchet"``) keeps its
+        fitness and its stored evaluation (``genome.evaluation``), entered in this generation's
+        statistics with no steps or time of its own.
+        """
+        carried = {key for key in getattr(self._population.reproduction, "carried", ())
+                   if getattr(dict(genomes).get(key), "evaluation", None) is not None}
+        kept = {key: dict(genomes)[key] for key in carried}
+        genomes = [(key, g) for key, g in genomes if key not in carried]
         evaluations = self._evaluator.map([g for _, g in genomes], self._generation)
         self._current = {}
         for key, error in self._evaluator.failures:
@@ -226,8 +252,14 @@ class Trainer:
                             f"{first}; all in {self.run_dir / 'errors.log'}); the run stopped: fix the cause and "
                             f"continue with gathering-evolve --resume {self.run_dir}")
         self._evaluator.failures.clear()
+        ratchet = self.experiment.elitism == "ratchet"
         for (key, g), ev in zip(genomes, evaluations):
             g.fitness = ev.task
             g.objectives = ev.objectives(self.experiment.objectives)
+            if ratchet:
+                g.evaluation = ev
             self._current[key] = ev
-        self._current_genomes = dict(genomes)
+        for key, g in kept.items():
+            self._current[key] = replace(g.evaluation, steps=0, seconds_env=0.0, seconds_controller=0.0,
+                                         seconds_decode=0.0)
+        self._current_genomes = dict(genomes) | kept
