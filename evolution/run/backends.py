@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 from evolution.run.evaluate import Evaluation, evaluate
+from evolution.run.lock import drop_inherited_locks
 
 BACKENDS = ("serial", "process", "ray")
 
@@ -102,6 +103,7 @@ def _exit_when_orphaned(parent: int) -> None:
 def _init_worker(context: EvalContext, parent: int) -> None:
     global _WORKER_CONTEXT
     _WORKER_CONTEXT = context
+    drop_inherited_locks()  # the run directory's lock stays the trainer's alone
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     # Forked workers inherit the trainer's Python signal handlers: drop them. Ctrl-C reaches
     # the whole process group and the trainer decides what to do, so workers ignore SIGINT;
