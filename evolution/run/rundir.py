@@ -23,7 +23,7 @@ import neat
 
 from evolution.guard import UsageError, check_output_dir
 from evolution.run.champion import read_json
-from evolution.run.checkpoint import CheckpointError, load_checkpoint
+from evolution.run.checkpoint import CheckpointError, atomic_write_bytes, load_checkpoint
 from evolution.run.experiment import Experiment, ExperimentError, experiment_from_run
 from evolution.run.lock import LOCK_FILE
 from evolution.run.neat_setup import make_neat_config, substrate_for
@@ -177,10 +177,10 @@ def _rebuild_files(recorder: RunRecorder, recorded: Any, finished: bool) -> None
     run_dir, experiment = recorder.run_dir, recorder.experiment
     run_dir.mkdir(parents=True, exist_ok=True)
     if recorded is None or (not finished and recorded.get("generations") != experiment.generations):
-        (run_dir / "experiment.json").write_text(json.dumps(experiment.to_dict(), indent=1) + "\n")
+        atomic_write_bytes(run_dir / "experiment.json", (json.dumps(experiment.to_dict(), indent=1) + "\n").encode())
     if not (run_dir / "neat.cfg").exists():
         if recorder.neat_cfg_text is not None:
-            (run_dir / "neat.cfg").write_text(recorder.neat_cfg_text, encoding="utf-8")
+            atomic_write_bytes(run_dir / "neat.cfg", recorder.neat_cfg_text.encode())
         else:
             warnings.warn(f"{run_dir / 'neat.cfg'}: missing and this (older) checkpoint cannot rebuild it; "
                           "the run goes on with the config stored in the checkpoint", stacklevel=3)

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from evolution.guard import writing
 from evolution.run.checkpoint import atomic_write_bytes
 from evolution.run.evaluate import Evaluation
 from gathering_env import SENSOR_TYPES
@@ -119,7 +120,7 @@ def write_stats(path: Path, records: Sequence[dict[str, Any]]) -> None:
 def append_stats(path: Path, record: dict[str, Any]) -> None:
     """Append one record to ``stats.jsonl`` (fsync'ed) and refresh ``stats.csv``."""
     path = Path(path)
-    with open(path, "a", encoding="utf-8") as f:
+    with writing(path), open(path, "a", encoding="utf-8") as f:
         f.write(json.dumps(record, allow_nan=False) + "\n")
         f.flush()
         os.fsync(f.fileno())

@@ -29,7 +29,7 @@ from typing import Any
 
 import neat
 
-from evolution.guard import UsageError, describe_os_error
+from evolution.guard import UsageError, describe_os_error, writing
 from evolution.run.backends import EvalContext, make_evaluator
 from evolution.run.evaluate import Evaluation
 from evolution.run.experiment import Experiment
@@ -245,7 +245,7 @@ class Trainer:
         evaluations = self._evaluator.map([g for _, g in genomes], self._generation)
         self._current = {}
         for key, error in self._evaluator.failures:
-            with open(self.run_dir / "errors.log", "a", encoding="utf-8") as log:
+            with writing(self.run_dir / "errors.log"), open(self.run_dir / "errors.log", "a", encoding="utf-8") as log:
                 log.write(f"generation {self._generation} genome {key}: {error}\n")
         self._failures = len(self._evaluator.failures)
         if genomes and self._failures == len(genomes):
