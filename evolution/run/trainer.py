@@ -71,7 +71,7 @@ class Trainer:
     folder; a resumed run verified before anything is written). The record and every file
     written from it: ``evolution.run.recorder.RunRecorder`` (``self.recorder``).
 
-    SIGINT/SIGTERM: the first signal lets the current generation finish (its statistics and
+    SIGINT/SIGTERM/SIGHUP: the first signal lets the current generation finish (its statistics and
     checkpoint are written) and then stops; a second one abandons the generation at once. Either
     way the run resumes from its last checkpoint.
     """
@@ -229,7 +229,7 @@ class Trainer:
                   "(again to abandon it); resume with --resume", flush=True)
 
         previous = {}
-        for sig in (signal.SIGINT, signal.SIGTERM):
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):  # SIGHUP: the terminal closed
             previous[sig] = signal.signal(sig, request_stop)
         return previous
 
