@@ -1,12 +1,13 @@
 # make test   : create .venv if missing, install the project with its test extras, run the fast tests
 # make demo   : set up and run the main job
 # make bench  : print the environment and generation benchmarks
+# make bench-learning : the learning benchmark (S1 and M1 at a mid budget, held-out comparison)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test test-slow demo bench lint clean
+.PHONY: test test-slow demo bench bench-learning lint clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -34,6 +35,12 @@ demo: $(STAMP)
 bench: $(STAMP)
 	$(PY) benchmarks/bench_env.py
 	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_generation.py
+
+# Does evolution learn? S1 and M1 at a mid budget (about an hour on 2 idle cores), then the
+# champions against scripted teams on held-out layouts (docs/evidence.md). Resumable:
+# make bench-learning ARGS=--resume
+bench-learning: $(STAMP)
+	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_learning.py --out runs/bench-learning $(ARGS)
 
 lint: $(STAMP)
 	$(PY) -m ruff check .

@@ -12,6 +12,8 @@ Layout (every key optional except where noted; defaults are the paper's, SPEC se
     trials = 5                   # trials (episodes) per genome, mean ft is the fitness
     convergence_stop = true      # SO only: stop once the best genome gathers all blocks in
                                  # half the allowed steps (mean ft >= 100 + bonus / 2)
+    speciation = "adaptive"      # optional: overrides the neat config's species_mode
+                                 # ("adaptive" | "original" | "fixed", evolution.reproduction.species)
     neat_config = "hyperneat_m.neat.cfg"   # neat-python config (see "neat_config" below)
 
     [environment]                # any gathering_env keyword: environment, max_cycles, ...
@@ -60,6 +62,16 @@ PRESET_PACKAGE = "evolution.presets"
 LIMITS: dict[str, tuple[int, float]] = {
     "seed": (0, math.inf), "generations": (1, 100_000), "population": (2, 10_000), "trials": (1, 1_000),
 }
+
+
+def _species_modes() -> tuple[str, ...]:
+    from evolution.reproduction.species import MODES
+
+    return MODES
+
+
+#: Keys whose value is one of a few names.
+CHOICES = {"method": lambda: METHODS, "speciation": _species_modes}
 
 
 class ExperimentError(ValueError):
@@ -143,6 +155,7 @@ class Experiment:
     population: int = 150
     trials: int = 5
     convergence_stop: bool = True
+    speciation: str | None = None  # None: the neat config's [GatheringSpeciesSet] species_mode
     neat_config: Path = field(default_factory=lambda: CONFIG_DIR / DEFAULT_NEAT_CONFIGS["hyperneat-m"])
     environment: dict[str, Any] = field(default_factory=lambda: {"environment": 2, "max_cycles": 10_000})
     substrate: dict[str, Any] = field(default_factory=dict)
@@ -206,7 +219,7 @@ def experiment_from_run(saved: dict[str, Any], source: str, overrides: dict[str,
     """
     if not isinstance(saved, dict):
         raise ExperimentError(f"{source}: the saved experiment is not a JSON object")
-    section = {k: v for k, v in saved.items() if k in _EXPERIMENT_KEYS}
+    section = {k: v for k, v in saved.items() if k in _EXPERIMENT_KEYS and v is not None}  # None: not set
     if neat_config is not None:
         section["neat_config"] = str(Path(neat_config).resolve())
     raw = {"experiment": section, "environment": saved.get("environment"), "substrate": saved.get("substrate", {})}
@@ -278,9 +291,9 @@ def _check_key(source: str, key: str, value: Any) -> Any:
         if not isinstance(value, str) or not value or any(c in value for c in "/\\"):
             raise ExperimentError(f"{where}={value!r} must be a non-empty name without slashes")
         return value
-    if key == "method":
-        if value not in METHODS:
-            raise ExperimentError(f"{where}={value!r}; allowed: {list(METHODS)}")
+    if key in CHOICES:
+        if value not in CHOICES[key]():
+            raise ExperimentError(f"{where}={value!r}; allowed: {list(CHOICES[key]())}")
         return value
     if key == "objectives":
         if isinstance(value, str):
