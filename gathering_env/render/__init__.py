@@ -21,7 +21,7 @@ option with a picture):
 Render options (``Renderer(...)``, ``parallel_env(render_options={...})``,
 ``env.render(**options)``, ``gathering-replay --cones/--view/--size/--trail/--no-panel``):
 
-``size_px``      side of the square arena view in pixels (>= 64); the panel adds width.
+``size_px``      side of the square arena view in pixels (64..4096); the panel adds width.
 ``cones``        ``"auto"`` (default), ``"all"``, ``"none"`` or robot indices (``[3]``, ``"0,3"``).
                  ``"auto"`` is ``"all"`` while the team's summed cone area is at most
                  ``AUTO_CONES_COVER`` of the arena, otherwise the cones of one robot (the followed
