@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import fcntl
 import os
+import time
 import warnings
 from pathlib import Path
 
@@ -61,11 +62,21 @@ class RunLock:
             self.run_dir.mkdir(parents=True, exist_ok=True)
         elif not self.path.is_file():
             return
-        fd = os.open(self.path, os.O_RDWR | (os.O_CREAT if create else 0), 0o644)
+        try:
+            fd = os.open(self.path, os.O_RDWR | (os.O_CREAT if create else 0), 0o644)
+        except (PermissionError, FileNotFoundError):
+            if create:
+                raise
+            return  # a lock file this user cannot write: the first write will say what is wrong
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             holder = _read_pid(fd)
+            for _ in range(10):  # the holder writes its PID just after taking the lock
+                if holder:
+                    break
+                time.sleep(0.05)
+                holder = _read_pid(fd)
             os.close(fd)
             who = f"process {holder}" if holder else "another process"
             raise UsageError(f"{self.run_dir}: run directory is in use by {who} (a gathering-evolve run); "
