@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import time
+from datetime import datetime, timedelta
 from pathlib import Path
 
 import pytest
@@ -46,8 +47,12 @@ def still_alive(known: dict[int, int]) -> dict[int, int]:
 def test_local_ray_that_fails_to_start_names_the_cause_from_its_log(tmp_path, capsys, monkeypatch):
     exp = write_tiny(tmp_path)
     temp = tmp_path / "raytmp"
-    logs = temp / "ray" / f"session_2026-12-01_17-45-44_360481_{os.getpid()}" / "logs"
+    now = datetime.now()
+    logs = temp / "ray" / f"session_{now:%Y-%m-%d_%H-%M-%S_%f}_{os.getpid()}" / "logs"
     logs.mkdir(parents=True)
+    old = temp / "ray" / f"session_{now - timedelta(minutes=5):%Y-%m-%d_%H-%M-%S_%f}_{os.getpid()}" / "logs"
+    old.mkdir(parents=True)  # an earlier Ray of this process: its errors are not this start's
+    (old / "raylet.out").write_text("[2026-12-01 17:40:00,000 E 1 2] (raylet) x.cc:1: an old error\n")
     (logs / "raylet.out").write_text(RAYLET_OUT)
     (logs / "gcs_server.out").write_text("[2026-12-01 17:45:45,001 I 1 2] (gcs_server) gcs.cc:1: started\n")
     monkeypatch.setenv("RAY_TMPDIR", str(temp))
@@ -62,6 +67,7 @@ def test_local_ray_that_fails_to_start_names_the_cause_from_its_log(tmp_path, ca
     err = one_error_line(capsys)
     assert "Ray did not start (The current node timed out during startup" in err
     assert f"raylet: mmap failed with error: Cannot allocate memory (Ray's log {logs / 'raylet.out'})" in err
+    assert "an old error" not in err
     assert not (tmp_path / "r").exists()
 
 

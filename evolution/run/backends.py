@@ -24,6 +24,7 @@ import traceback
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
+from datetime import datetime
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -285,10 +286,10 @@ def ray_log_cause(since: float) -> str | None:
     root = Path(os.environ.get("RAY_TMPDIR") or tempfile.gettempdir()) / "ray"
     found: list[tuple[str, str, Path]] = []
     for session in root.glob(f"session_*_{os.getpid()}"):
-        try:
-            if session.stat().st_mtime < since - 5:
+        try:  # session_<local date and time>_<driver pid>: only a session of this start
+            if datetime.strptime(session.name[8:34], "%Y-%m-%d_%H-%M-%S_%f").timestamp() < since - 2:
                 continue
-        except OSError:
+        except ValueError:
             continue
         for log in sorted((session / "logs").glob("*.[eo][ru][rt]")):  # *.err, *.out
             try:
