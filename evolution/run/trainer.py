@@ -8,6 +8,7 @@ One call of ``Trainer.run()`` evolves an ``Experiment`` into a run directory::
     RUN_DIR/checkpoints/gen-NNNN.ckpt  state before generation NNNN is evaluated
     RUN_DIR/champion.json          best genome so far by task performance (JSON, no pickle)
     RUN_DIR/stats.png              fitness and simplicity over generations (at the end)
+    RUN_DIR/.lock                  the writer's lock and PID (evolution.run.lock)
 
 neat-python's ``Population.run(fitness, 1)`` is called once per generation: it evaluates the
 population through our fitness function (which hands the genomes to the backend), reports,
@@ -68,7 +69,8 @@ class Trainer:
             ``experiment`` is None (only ``generations`` and ``name`` may differ from the run).
 
     Output folder: the rules of ``evolution.run.rundir`` (a new run into a missing or empty
-    folder; a resumed run verified before anything is written). The record and every file
+    folder; a resumed run verified before anything is written; one writer at a time, by the
+    run directory's lock, ``evolution.run.lock``). The record and every file
     written from it: ``evolution.run.recorder.RunRecorder`` (``self.recorder``).
 
     SIGINT/SIGTERM/SIGHUP: the first signal lets the current generation finish (its statistics and
@@ -120,7 +122,7 @@ class Trainer:
 
     # ------------------------------------------------------------------ loop
     def run(self) -> RunResult:
-        """Evolve; the run directory is locked (``evolution.run.rundir.RunLock``) throughout."""
+        """Evolve; the run directory is locked (``evolution.run.lock.RunLock``) throughout."""
         self._lock = RunLock(self.run_dir)
         try:
             self._lock.acquire(create=False)  # a run directory in use is refused before any work
