@@ -46,6 +46,24 @@ def test_streamed_gif_holds_every_frame_in_order(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.gif"]   # no temporary file left
 
 
+def test_pixels_unchanged_since_the_previous_frame_keep_showing_it(tmp_path):
+    """Unchanged pixels are written transparent: every frame still reads back whole, and a
+    small moving square costs a fraction of redrawing every frame."""
+    background = frames(1, h=96, w=128)[0]
+    shown = []
+    for i in range(6):
+        frame = background.copy()
+        frame[10 + 5 * i: 20 + 5 * i, 30 + 8 * i: 40 + 8 * i] = (255, 0, 0)
+        shown.append(frame)
+    path = save_video(shown, tmp_path / "square.gif", fps=10)
+    back = imageio.mimread(path)
+    assert len(back) == 6
+    for original, read in zip(shown, back):
+        assert np.abs(read[..., :3].astype(int) - original.astype(int)).max() == 0
+    redrawn = save_video([np.roll(f, 1, axis=0) if i % 2 else f for i, f in enumerate(shown)], tmp_path / "all.gif")
+    assert path.stat().st_size < 0.5 * redrawn.stat().st_size
+
+
 def test_a_failed_write_leaves_no_partial_file_and_keeps_an_earlier_one(tmp_path, monkeypatch):
     earlier = save_video(frames(2), tmp_path / "a.gif")
     before = earlier.read_bytes()

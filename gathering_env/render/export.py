@@ -1,7 +1,8 @@
 """Writing pictures and videos: ``save_png``, ``save_video`` and the streaming ``VideoWriter``.
 
 ``VideoWriter`` encodes each frame as it arrives (a GIF through Pillow's GIF encoder, frame by
-frame, each with its own palette; an MP4 through ``imageio-ffmpeg``), so a replay's memory does
+frame, each with its own palette and the pixels unchanged since the previous frame transparent;
+an MP4 through ``imageio-ffmpeg``), so a replay's memory does
 not grow with its number of frames. Every file is written to a hidden temporary file beside the
 target and renamed over it only once complete: a failure (a full disk, a bad frame, Ctrl-C)
 leaves no partial file and an earlier output intact, and its ``OSError`` names the target.
@@ -94,20 +95,37 @@ def _check_video_args(path: Path, fps: Any) -> str:
 
 
 class _GifStream:
-    """An animated GIF written frame by frame (Pillow's GIF header and frame encoders)."""
+    """An animated GIF written frame by frame (Pillow's GIF header and frame encoders).
+
+    Each frame gets its own palette of up to 255 colours; index 255 is transparent and marks
+    the pixels equal to the previous frame (they keep showing it), so unchanged areas cost
+    almost nothing, as in Pillow's own multi-frame writer. Only the previous frame is kept.
+    """
+
+    TRANSPARENT = 255
 
     def __init__(self, fp: IO[bytes], fps: float) -> None:
         self.fp, self.ms, self.count = fp, max(10, round(1000.0 / fps)), 0
+        self._previous: np.ndarray | None = None
 
     def add(self, frame: np.ndarray) -> None:
         from PIL import GifImagePlugin, Image
 
-        im = Image.fromarray(frame, "RGB").convert("P", palette=Image.Palette.ADAPTIVE)
+        quantized = Image.fromarray(frame, "RGB").convert("P", palette=Image.Palette.ADAPTIVE, colors=255)
+        palette = (quantized.getpalette() or [])[:3 * 255]
+        palette += [0] * (3 * 256 - len(palette))
+        index = np.asarray(quantized)
+        if self._previous is not None:
+            index = np.where((frame == self._previous).all(axis=2), np.uint8(self.TRANSPARENT), index)
+        im = Image.fromarray(index.astype(np.uint8), "P")
+        im.putpalette(palette)
         if self.count == 0:
             header, _ = GifImagePlugin.getheader(im, info={"loop": 0, "duration": self.ms})
             self.fp.write(b"".join(header))
-        for chunk in GifImagePlugin.getdata(im, duration=self.ms, include_color_table=True):
+        for chunk in GifImagePlugin.getdata(im, duration=self.ms, include_color_table=True, disposal=1,
+                                            transparency=self.TRANSPARENT):
             self.fp.write(chunk)
+        self._previous = frame.copy()
         self.count += 1
 
     def close(self) -> None:
