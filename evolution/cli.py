@@ -97,6 +97,9 @@ def evolve_main(argv: list[str] | None = None) -> int:
     group.add_argument("--steps", type=int, help="steps per trial (max_cycles)")
     group.add_argument("--robots", type=int, help="team size (num_robots)")
     args = parser.parse_args(argv)
+    if args.ray_address is not None and args.backend != "ray":
+        raise UsageError(f"--ray-address {args.ray_address}: only used with --backend ray (the backend is "
+                         f"{args.backend}); allowed: add --backend ray, or drop --ray-address")
     if args.list:
         return _list_presets()
     if args.dump is not None:
@@ -212,6 +215,9 @@ def replay_main(argv: list[str] | None = None) -> int:
     if args.no_panel:
         render_options["panel"] = False
     check_output_file(args.out, (".gif", ".mp4"), "--out")
+    if args.png is not None and args.sensors_png is not None and args.png.resolve() == args.sensors_png.resolve():
+        raise UsageError(f"--sensors-png {args.sensors_png}: the same file as --png (one would overwrite the "
+                         "other); allowed: two different file names")
     for picture, flag in ((args.png, "--png"), (args.sensors_png, "--sensors-png")):
         if picture is not None:
             check_output_file(picture, (".png",), flag)

@@ -268,13 +268,18 @@ def test_rl_ppo_example_trains_saves_snapshots_and_evaluates(tmp_path):
     (["--gamma", "nan"], "--gamma: nan is out of range; allowed: a number > 0.0 and <= 1.0"),
     (["--learning-rate", "0"], "--learning-rate: 0 is out of range"),
     (["--robots", "100000"], "num_robots=100000 out of range"),
-    (["--wheel-levels", "1"], "wheel_levels=1; allowed: None"),
+    (["--wheel-levels", "1"], "--wheel-levels: 1 is out of range; allowed: 2..101"),
+    (["--timesteps", "30"], "--timesteps 30: conflicts with --env-steps 10"),   # was: --env-steps ignored
+    (["--out", "{tmp}/trained"], "holds a trained model (model.zip), which is never overwritten"),
 ])
 def test_rl_ppo_example_refuses_bad_input_in_one_line(tmp_path, capsys, argv, needle):
     """A wrong path, a folder with someone's files, a nonsense number: one line, exit 2, and
     nothing written (no output folder made, the user's file untouched)."""
     (tmp_path / "full").mkdir()
     (tmp_path / "full" / "notes.txt").write_text("keep")
+    if "{tmp}/trained" in argv:  # an earlier run's output, with its trained model
+        (tmp_path / "trained").mkdir()
+        (tmp_path / "trained" / "model.zip").write_bytes(b"PK trained weights")
     argv = [a.format(tmp=tmp_path) for a in argv]
     if "--out" not in argv:
         argv += ["--out", str(tmp_path / "new")]
@@ -285,5 +290,7 @@ def test_rl_ppo_example_refuses_bad_input_in_one_line(tmp_path, capsys, argv, ne
     assert code == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("error: ") and len(err.splitlines()) == 1 and needle in err, err
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["full"]
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name != "trained") == ["full"]
     assert (tmp_path / "full" / "notes.txt").read_text() == "keep"
+    if (tmp_path / "trained").exists():
+        assert (tmp_path / "trained" / "model.zip").read_bytes() == b"PK trained weights"

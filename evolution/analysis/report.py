@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from evolution.analysis.fronts import SELECTION_POINTS, Analysis  # noqa: E402
-from evolution.guard import check_output_dir  # noqa: E402
+from evolution.guard import check_output_dir, writing  # noqa: E402
 
 ENV_COLOURS = {1: "tab:blue", 2: "tab:orange", 3: "tab:red"}
 POINT_MARKERS = {"max": "^", "mean": "s", "knee": "D", "epsilon": "P"}
@@ -22,7 +22,7 @@ POINT_MARKERS = {"max": "^", "mean": "s", "knee": "D", "epsilon": "P"}
 def write_table4(analysis: Analysis, out: Path) -> tuple[Path, Path]:
     rows = [c.__dict__ for c in analysis.comparisons]
     csv_path = out / "table4.csv"
-    with open(csv_path, "w", newline="") as f:
+    with writing(csv_path), open(csv_path, "w", newline="") as f:
         if rows:
             writer = csv.DictWriter(f, fieldnames=list(rows[0]))
             writer.writeheader()
@@ -44,7 +44,8 @@ def write_table4(analysis: Analysis, out: Path) -> tuple[Path, Path]:
                     parts.append(f"{c.superior} {abs(c.difference_percent):.1f} % (p={c.p_value:.2g})")
         lines.append(f"| {point} | " + " | ".join(parts) + " |")
     md_path = out / "table4.md"
-    md_path.write_text("\n".join(lines) + "\n")
+    with writing(md_path):
+        md_path.write_text("\n".join(lines) + "\n")
     return md_path, csv_path
 
 
@@ -71,7 +72,8 @@ def figure4(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="best")
     path = out / "figure4_fronts.png"
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
@@ -93,7 +95,8 @@ def figure5(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7)
     path = out / "figure5_simplicity.png"
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
@@ -117,7 +120,8 @@ def figure6(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7)
     path = out / "figure6_points.png"
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
@@ -163,5 +167,6 @@ def write_report(analysis: Analysis, out: Path) -> Path:
               f"are in `{table_csv.name}`.", "", table_md.read_text(), "## Figures", ""]
     lines += [f"![{f.stem}]({f.name})" for f in figs]
     path = out / "report.md"
-    path.write_text("\n".join(lines) + "\n")
+    with writing(path):
+        path.write_text("\n".join(lines) + "\n")
     return path

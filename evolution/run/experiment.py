@@ -193,10 +193,13 @@ def preset_description(name: str) -> str:
 def is_preset_name(arg: str) -> bool:
     """Whether a command-line EXPERIMENT argument means a preset rather than a file.
 
-    A preset name has no path separator and no ``.toml`` suffix and is not an existing file;
-    anything else is a path, as before presets existed.
+    A preset name has no path separator and no ``.toml`` suffix and is not an existing file,
+    nor an existing folder unless it is a shipped preset's name; anything else is a path (so a
+    folder is reported as a folder, not as an unknown preset).
     """
-    return not (any(sep in arg for sep in "/\\") or arg.endswith(".toml") or Path(arg).is_file())
+    if any(sep in arg for sep in "/\\") or arg.endswith(".toml") or Path(arg).is_file():
+        return False
+    return arg in preset_names() or not Path(arg).exists()
 
 
 @dataclass(frozen=True)
