@@ -73,7 +73,7 @@ def presets_dir() -> Path:
     folder; in an installed wheel, the package ``evolution.presets`` that setuptools
     built from that folder.
     """
-    checkout = Path(__file__).resolve().parent.parent
+    checkout = Path(__file__).resolve().parents[2]  # evolution/run/experiment.py -> the checkout
     if (checkout / "pyproject.toml").is_file() and (checkout / "configs" / "__init__.py").is_file():
         return checkout / "configs"
     return Path(str(resources.files(PRESET_PACKAGE)))
