@@ -13,9 +13,7 @@ import pytest
 import small_runs
 from small_runs import evolve, experiment_file
 
-from evolution.analysis.reevaluate import _run_setup
 from evolution.run import trainer as trainer_module
-from evolution.run.champion import genome_from_dict, load_champion
 from evolution.run.evaluate import Evaluation, evaluate, sensor_statistics, trial_seed
 from evolution.run.experiment import load_experiment
 from evolution.run.stats import read_stats, without_timing
@@ -39,18 +37,31 @@ def team_ft(controller, morphology, env_config, seed):
             return env.team_info()["task_performance"]
 
 
-def test_fitness_is_the_mean_ft_over_distinct_trial_seeds(mo_run):
-    _, run = mo_run
-    experiment, config, substrate = _run_setup(run)
-    champion = load_champion(run / "champion.json")
-    genome = genome_from_dict(champion.genome, config)
-    seeds = [trial_seed(experiment.seed, 1, t) for t in range(4)]
-    assert len(set(seeds)) == 4
-    ev = evaluate(genome, config, experiment.environment, trials=4, seed=experiment.seed, generation=1,
-                  method=experiment.method, substrate=substrate)
-    reference = [team_ft(champion.controller, champion.morphology, experiment.environment, s) for s in seeds]
-    assert ev.trial_ft == pytest.approx(reference)
-    assert ev.task == pytest.approx(sum(reference) / 4)
+def test_fitness_is_the_mean_ft_over_distinct_trial_seeds():
+    """A hand-built CPPN (both wheels forward, the right one faster from the x2 link) whose
+    trial scores differ: the fitness is their mean, each trial on its own seed."""
+    import neat
+    from neat.innovation import InnovationTracker
+    from test_substrate import BIAS, CFG, X2, cppn
+
+    from evolution.encodings.genome import CPPNGenome
+    from evolution.encodings.substrate import Substrate, decode
+    from evolution.reproduction.breeding import NEATReproduction
+
+    config = neat.Config(CPPNGenome, NEATReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(CFG))
+    config.genome_config.innovation_tracker = InnovationTracker()
+    genome = cppn(config, {(X2, BIAS): 1.0}, biases={BIAS: 0.3})
+    world = dict(environment=1, arena_width=6.0, arena_height=6.0, zone_width=6.0, zone_depth=2.0,
+                 block_counts=[12, 0, 0], max_cycles=150, num_robots=10)
+    seeds = [trial_seed(3, 1, t) for t in range(5)]
+    assert len(set(seeds)) == 5
+    controller, morphology = decode(genome, config, Substrate())
+    reference = [team_ft(controller, morphology, world, s) for s in seeds]
+    assert len(set(reference)) >= 3                   # the trials' scores differ (else mean = max = any)
+    ev = evaluate(genome, config, world, trials=5, seed=3, generation=1, method="hyperneat-m")
+    assert ev.trial_ft == pytest.approx(reference)    # trial t ran on seed t, in order
+    assert ev.task == pytest.approx(sum(reference) / 5)
+    assert ev.task != pytest.approx(max(reference)) and ev.task != pytest.approx(reference[0])
 
 
 def test_front_files_are_non_dominated(mo_run):
