@@ -1,12 +1,13 @@
 # make test   : create .venv if missing, install the project with its test extras, run the fast tests
 # make demo   : set up and run the main job
 # make bench  : print the environment and generation benchmarks
+# make mutation: mutation testing (mutmut) of the study-critical modules; survivors -> mutation-survivors.txt
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test test-slow demo bench lint clean
+.PHONY: test test-slow demo bench lint clean mutation
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -35,8 +36,17 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_env.py
 	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_generation.py
 
+# Mutation testing ([tool.mutmut] in pyproject.toml; docs/testing.md). CPU-heavy: restrict it with
+# MUTANTS, mutmut's name globs, e.g. make mutation MUTANTS='evolution.reproduction.pareto*'.
+MUTANTS ?=
+mutation: $(STAMP)
+	$(PY) -m pip install --quiet "mutmut>=3.8,<4"
+	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy nice -n 15 $(VENV)/bin/mutmut run --max-children 2 $(MUTANTS) || true
+	$(VENV)/bin/mutmut results > mutation-survivors.txt
+	@echo "survivors: $$(grep -c ': survived' mutation-survivors.txt) (mutation-survivors.txt; 'mutmut show NAME' for one)"
+
 lint: $(STAMP)
 	$(PY) -m ruff check .
 
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) out .pytest_cache mutants mutation-survivors.txt

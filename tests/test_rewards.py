@@ -222,10 +222,11 @@ def test_pettingzoo_api_test_with_local_shaped_rewards():
 def test_local_credit_of_blocks_nobody_holds_is_shared_by_everyone():
     """RewardShaper by hand, two worlds of four robots and three blocks. World 0: robots 0 and
     1 hold block 0, robot 3 holds block 2 and lets go, robot 2 attaches to block 1, which nobody
-    held at the start of the step. World 1: nobody holds anything. Each block moves 0.5, 0.3 or
-    0.1 towards the zone; the documented split: a held block's potential change to its holders
+    held at the start of the step. Each block moves 0.5, 0.3 or
+    0.1 towards the zone. The documented split: a held block's potential change to its holders
     at the start of the step (equally), a free block's change to all four robots equally, the
-    attachment term to the robot that attached or let go, the task reward to all equally."""
+    attachment term to the robot that attached or let go, the task reward to all equally.
+    World 1: robot 1 holds block 2 throughout, blocks 0 and 1 are free."""
     from gathering_env.rewards import RewardShaper
 
     cfg = WorldConfig.from_kwargs(environment=None, block_counts=(3, 0, 0), num_robots=4, reward="shaped",
@@ -235,8 +236,8 @@ def test_local_credit_of_blocks_nobody_holds_is_shared_by_everyone():
     start = np.array([[x0 + 2.0, y1 + 3.0], [x0 + 4.0, y1 + 2.0], [x0 + 6.0, y1 + 1.0]])
     step = np.array([0.5, 0.3, 0.1])
     end = start - np.stack([np.zeros(3), step], axis=1)              # straight south, towards the zone
-    before = np.array([[0, 0, -1, 2], [-1, -1, -1, -1]])
-    after = np.array([[0, 0, 1, -1], [-1, -1, -1, -1]])
+    before = np.array([[0, 0, -1, 2], [-1, 2, -1, -1]])
+    after = np.array([[0, 0, 1, -1], [-1, 2, -1, -1]])
     shaper = RewardShaper(cfg, half, value)
     shaper.before(np.stack([start, start]), before)
     task = np.array([4.0, 0.0])
@@ -252,7 +253,8 @@ def test_local_credit_of_blocks_nobody_holds_is_shared_by_everyone():
     expected[0, :] += change[1] / 4                                   # block 1: nobody held it -> everyone
     expected[0, 2] += 0.5                                             # robot 2 attached
     expected[0, 3] -= 0.5                                             # robot 3 let go
-    expected[1, :] += change.sum() / 4                                # world 1: all blocks free
+    expected[1, 1] += change[2]                                       # world 1: robot 1 holds block 2,
+    expected[1, :] += (change[0] + change[1]) / 4                     # blocks 0 and 1 are free
     np.testing.assert_allclose(robot, expected, rtol=0, atol=1e-12)
     np.testing.assert_allclose(team, task + change.sum(), rtol=0, atol=1e-12)
     np.testing.assert_allclose(robot.sum(axis=1), team, rtol=0, atol=1e-12)
