@@ -13,6 +13,7 @@ import pytest
 from evolution.encodings.controller import TeamController
 from evolution.encodings.direct import NEATMGenome, decode_neat_m
 from evolution.reproduction.breeding import NEATReproduction
+from evolution.reproduction.species import GatheringSpeciesSet
 
 CFG = Path(__file__).resolve().parent.parent / "configs" / "neat_m.neat.cfg"
 
@@ -56,7 +57,7 @@ def test_round_trip_through_dict():
 
 def test_neat_m_network_matches_neat_feed_forward_per_robot():
     """A NEAT-M genome with hidden nodes: our layered batch vs neat-python's own network."""
-    config = neat.Config(NEATMGenome, NEATReproduction, neat.DefaultSpeciesSet,
+    config = neat.Config(NEATMGenome, NEATReproduction, GatheringSpeciesSet,
                          neat.DefaultStagnation, str(CFG))
     population = neat.Population(config, seed=4)
     random.seed(4)

@@ -19,6 +19,7 @@ from evolution.encodings.genome import CPPNGenome
 from evolution.encodings.substrate import Substrate, decode
 from evolution.reproduction.breeding import BreedingGenome, NEATReproduction, breed, truncate
 from evolution.reproduction.mods import MODSReproduction
+from evolution.reproduction.species import GatheringSpeciesSet
 from gathering_env import SENSOR_TYPES
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
@@ -33,7 +34,7 @@ CFG_FILES = {CPPNGenome: "hyperneat_m.neat.cfg", NEATMGenome: "neat_m.neat.cfg"}
 
 
 def load(genome_type, reproduction=NEATReproduction, path=None):
-    return neat.Config(genome_type, reproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation,
+    return neat.Config(genome_type, reproduction, GatheringSpeciesSet, neat.DefaultStagnation,
                        str(path or CONFIGS / CFG_FILES[genome_type]))
 
 
@@ -127,7 +128,7 @@ weight_mutate_power = 0.5
 weight_mutate_rate = 0.0
 weight_replace_rate = 0.0
 
-[DefaultSpeciesSet]
+[GatheringSpeciesSet]
 compatibility_threshold = 3.0
 
 [DefaultStagnation]
@@ -373,7 +374,7 @@ def copy_network(source, key):
     return other
 
 
-def test_entirely_different_sensors_make_another_species():
+def test_entirely_different_sensors_cost_the_whole_sensor_coefficient():
     config = neat_m()
     gc = config.genome_config
     a = NEATMGenome(1)
@@ -381,9 +382,9 @@ def test_entirely_different_sensors_make_another_species():
     a.sensors = {s: SensorGene("infrared", 0.5 * s, 0.0, 5.0, 1.0) for s in (0, 1, 2)}
     b = copy_network(a, 2)
     b.sensors = {s: SensorGene("camera", 0.5 * s, 0.0, 5.0, 1.0) for s in (0, 1, 2)}
-    threshold = config.species_set_config.compatibility_threshold
     assert a.distance(b, gc) == pytest.approx(gc.sensor_compatibility_coefficient)   # mean difference 1
-    assert a.distance(b, gc) > threshold
+    assert a.sensor_distance(b, gc) == pytest.approx(gc.sensor_compatibility_coefficient)
+    assert a.distance(copy_network(a, 3), gc) == 0.0
 
 
 def test_sensor_distance_by_hand():

@@ -15,13 +15,14 @@ from evolution.encodings.direct import NEATMGenome, SensorGene, decode_neat_m
 from evolution.encodings.genome import CPPNGenome
 from evolution.encodings.substrate import decode
 from evolution.reproduction.breeding import NEATReproduction
+from evolution.reproduction.species import GatheringSpeciesSet
 from gathering_env import SENSOR_TYPES, Morphology
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 
 
 def load(genome_type, name):
-    return neat.Config(genome_type, NEATReproduction, neat.DefaultSpeciesSet,
+    return neat.Config(genome_type, NEATReproduction, GatheringSpeciesSet,
                        neat.DefaultStagnation, str(CONFIGS / name))
 
 
@@ -108,7 +109,7 @@ def test_unknown_genome_key_is_an_error(tmp_path):
     path = tmp_path / "bad.cfg"
     path.write_text(text)
     with pytest.raises(ValueError, match="num_hiden"):
-        neat.Config(CPPNGenome, NEATReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
+        neat.Config(CPPNGenome, NEATReproduction, GatheringSpeciesSet, neat.DefaultStagnation, str(path))
 
 
 def test_cppn_needs_six_outputs(tmp_path):
@@ -117,7 +118,7 @@ def test_cppn_needs_six_outputs(tmp_path):
     path = tmp_path / "bad.cfg"
     path.write_text(text)
     with pytest.raises(ValueError, match="num_outputs=5"):
-        neat.Config(CPPNGenome, NEATReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
+        neat.Config(CPPNGenome, NEATReproduction, GatheringSpeciesSet, neat.DefaultStagnation, str(path))
 
 
 # ---------------------------------------------------------------------------- each operator, exactly

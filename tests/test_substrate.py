@@ -13,6 +13,7 @@ from neat.innovation import InnovationTracker
 from evolution.encodings.genome import CPPNGenome
 from evolution.encodings.substrate import Substrate, decode
 from evolution.reproduction.breeding import NEATReproduction
+from evolution.reproduction.species import GatheringSpeciesSet
 from gathering_env import SENSOR_TYPES, parallel_env
 
 CFG = Path(__file__).resolve().parent.parent / "configs" / "hyperneat_m.neat.cfg"
@@ -22,7 +23,7 @@ WEIGHT, FOV, ORIENT, RANGE, TYPE, BIAS = range(6)
 
 @pytest.fixture(scope="module")
 def config():
-    cfg = neat.Config(CPPNGenome, NEATReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(CFG))
+    cfg = neat.Config(CPPNGenome, NEATReproduction, GatheringSpeciesSet, neat.DefaultStagnation, str(CFG))
     cfg.genome_config.innovation_tracker = InnovationTracker()
     return cfg
 

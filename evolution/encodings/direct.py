@@ -219,13 +219,17 @@ class NEATMGenome(BreedingGenome):
             del self.sensors[random.choice(sorted(self.sensors))]
 
     def distance(self, other: Any, config: Any) -> float:
-        d = super().distance(other, config)
+        return super().distance(other, config) + self.sensor_distance(other, config)
+
+    def sensor_distance(self, other: Any, config: Any) -> float:
+        """The sensor genes' part of the speciation distance: the coefficient times the mean
+        gene difference over the slots either genome fills (a slot only one fills counts 1)."""
         slots = set(self.sensors) | set(other.sensors)
         if not slots:
-            return d
+            return 0.0
         total = sum(self.sensors[s].distance(other.sensors[s]) if s in self.sensors and s in other.sensors else 1.0
                     for s in slots)
-        return d + config.sensor_compatibility_coefficient * total / len(slots)
+        return config.sensor_compatibility_coefficient * total / len(slots)
 
 
 def decode_neat_m(genome: NEATMGenome, config: Any) -> tuple[TeamController, Morphology]:

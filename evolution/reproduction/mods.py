@@ -178,7 +178,7 @@ class MODSReproduction(DefaultClassConfig):
         for gid, g in pool.items():
             if getattr(g, "objectives", None) is None:
                 raise RuntimeError(f"genome {gid} has no 'objectives': the fitness function must set them")
-        species.speciate(config, pool, generation)
+        getattr(species, "speciate_pool", species.speciate)(config, pool, generation)
         species_of = dict(species.genome_to_species)
         self.species_of = species_of
         parent_ids, score, selected = self.select(pool, species_of, pop_size)

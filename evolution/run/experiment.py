@@ -12,6 +12,8 @@ Layout (every key optional except where noted; defaults are the paper's, SPEC se
     trials = 5                   # trials (episodes) per genome, mean ft is the fitness
     convergence_stop = true      # SO only: stop once the best genome gathers all blocks in
                                  # half the allowed steps (mean ft >= 100 + bonus / 2)
+    speciation = "adaptive"      # optional: overrides the neat config's species_mode
+                                 # ("adaptive" | "original" | "fixed", evolution.reproduction.species)
     neat_config = "hyperneat_m.neat.cfg"   # neat-python config (see "neat_config" below)
 
     [environment]                # any gathering_env keyword: environment, max_cycles, ...
@@ -140,6 +142,7 @@ class Experiment:
     population: int = 150
     trials: int = 5
     convergence_stop: bool = True
+    speciation: str | None = None  # None: the neat config's [GatheringSpeciesSet] species_mode
     neat_config: Path = field(default_factory=lambda: CONFIG_DIR / DEFAULT_NEAT_CONFIGS["hyperneat-m"])
     environment: dict[str, Any] = field(default_factory=lambda: {"environment": 2, "max_cycles": 10_000})
     substrate: dict[str, Any] = field(default_factory=dict)
@@ -203,7 +206,7 @@ def experiment_from_run(saved: dict[str, Any], source: str, overrides: dict[str,
     """
     if not isinstance(saved, dict):
         raise ExperimentError(f"{source}: the saved experiment is not a JSON object")
-    section = {k: v for k, v in saved.items() if k in _EXPERIMENT_KEYS}
+    section = {k: v for k, v in saved.items() if k in _EXPERIMENT_KEYS and v is not None}  # None: not set
     if neat_config is not None:
         section["neat_config"] = str(Path(neat_config).resolve())
     raw = {"experiment": section, "environment": saved.get("environment"), "substrate": saved.get("substrate", {})}
@@ -298,6 +301,12 @@ def _check_key(source: str, key: str, value: Any) -> Any:
     if key == "convergence_stop":
         if not isinstance(value, bool):
             raise ExperimentError(f"{where}={value!r} must be true or false")
+        return value
+    if key == "speciation":
+        from evolution.reproduction.species import MODES
+
+        if value not in MODES:
+            raise ExperimentError(f"{where}={value!r}; allowed: {list(MODES)}")
         return value
     if key == "neat_config":
         if not isinstance(value, (str, Path)):

@@ -12,6 +12,7 @@ from typing import Any
 
 import neat
 
+from evolution.reproduction.species import GatheringSpeciesSet, target_count, use_original_rule
 from evolution.run.experiment import Experiment, ExperimentError
 
 
@@ -45,12 +46,24 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
         reproduction = NEATReproduction
     try:
         config = neat.Config(genome_class(experiment.method), reproduction,
-                             neat.DefaultSpeciesSet, neat.DefaultStagnation, str(path))
+                             GatheringSpeciesSet, neat.DefaultStagnation, str(path))
     except Exception as err:  # neat raises several error types for broken files
-        raise ExperimentError(f"{path}: invalid neat-python config: {err}") from None
+        hint = ""
+        if "GatheringSpeciesSet" in str(err) and "[DefaultSpeciesSet]" in Path(path).read_text(errors="replace"):
+            hint = " (rename the section [DefaultSpeciesSet] to [GatheringSpeciesSet]: evolution.reproduction.species)"
+        raise ExperimentError(f"{path}: invalid neat-python config: {err}{hint}") from None
     check_neat_config(config, path)
     config.pop_size = experiment.population
-    config.no_fitness_termination = True  # the trainer decides when to stop
+    species = config.species_set_config
+    if experiment.speciation is not None:
+        species.species_mode = experiment.speciation
+        if experiment.speciation == "original":
+            use_original_rule(species, experiment.multi_objective, experiment.population)
+    if species.species_mode == "adaptive":
+        try:
+            target_count(species.target_species, experiment.population)
+        except ValueError as err:
+            raise ExperimentError(f"{path}: [GatheringSpeciesSet] {err} (the population)") from None
     return config
 
 
@@ -117,9 +130,6 @@ def check_neat_config(config: neat.Config, path: Path) -> None:
             raise bad(section, key, value, "gaussian, normal or uniform")
     if not 0 <= genome.num_hidden <= MAX_HIDDEN:
         raise bad(section, "num_hidden", genome.num_hidden, f"0..{MAX_HIDDEN}")
-    species = config.species_set_config
-    if not 0.0 < species.compatibility_threshold < float("inf"):
-        raise bad("DefaultSpeciesSet", "compatibility_threshold", species.compatibility_threshold, "a number > 0")
     stagnation = config.stagnation_config
     if stagnation.species_fitness_func not in ("max", "min", "mean", "median"):
         raise bad("DefaultStagnation", "species_fitness_func", stagnation.species_fitness_func,

@@ -94,10 +94,13 @@ class RunRecorder:
 
     # ------------------------------------------------------------------ generations
     def record(self, population: neat.Population, generation: int, species_count: int, seconds: float,
-               evaluations: dict[int, Evaluation], genomes: dict[int, Any], failures: int) -> dict[str, Any]:
-        """Keep and append the statistics of a finished generation; a better genome becomes the champion."""
+               evaluations: dict[int, Evaluation], genomes: dict[int, Any], failures: int,
+               threshold: float | None = None) -> dict[str, Any]:
+        """Keep and append the statistics of a finished generation (``species`` and the
+        compatibility ``threshold`` that formed them); a better genome becomes the champion."""
         best_key = max(evaluations, key=lambda k: (evaluations[k].task, -k))
         record = generation_record(generation, list(evaluations.values()), species_count, seconds, best_key)
+        record["threshold"] = None if threshold is None else float(threshold)
         record["failures"] = int(failures)
         best_task = evaluations[best_key].task
         if self.best is None or best_task > self.best[0]:

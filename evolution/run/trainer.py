@@ -149,11 +149,13 @@ class Trainer:
                 generation = population.generation
                 start = time.perf_counter()
                 species_count = len(population.species.species)
+                history = getattr(population.species, "history", None)
+                threshold = history[-1][1] if history else population.species.species_set_config.compatibility_threshold
 
                 self._generation = generation
                 population.run(self._fitness, 1)
                 record = recorder.record(population, generation, species_count, time.perf_counter() - start,
-                                         self._current, self._current_genomes, self._failures)
+                                         self._current, self._current_genomes, self._failures, threshold)
                 recorder.save_checkpoint(population)
                 if bar is not None:
                     bar.set_postfix(best_ft=f"{record['task_best']:.1f}", mean_ft=f"{record['task_mean']:.1f}")

@@ -1,0 +1,250 @@
+"""A species set that speciates: a compatibility threshold that holds a number of species.
+
+neat-python's ``DefaultSpeciesSet`` keeps one fixed ``compatibility_threshold``. Its genome
+distance is normalised by genome size, so a threshold tuned elsewhere can leave a whole
+population in one species (measured on the shipped HyperNEAT-M config at N = 150: 1.6 gives
+1-4 species), and NEAT's protection of new structure, and NEAT-MODS's species bound and round
+robin, are then gone. ``GatheringSpeciesSet`` is that species set (the same assignment of
+genomes to species, in the same deterministic order) with the threshold moved after every
+speciation, by ``species_mode`` in its config section ``[GatheringSpeciesSet]``:
+
+* ``adaptive`` (default): the threshold holds the species count near ``target_species``.
+  After each speciation (``adapted_threshold``): with fewer species than the target it is
+  multiplied by ``1 - threshold_step * (target - count) / target`` (down, in proportion to the
+  shortfall); with more, by ``1 + threshold_step``, but only in a generation that formed a new
+  species: existing species keep their closest genome whatever the threshold, so a surplus
+  shrinks only by extinction (stagnation, no offspring, NEAT-MODS's species bound) and a higher
+  threshold merely stops new species — raising it further while none form would wind it up.
+  Multiplicative steps reach the right scale from any start (neat-python's distances of CPPNs
+  lie around 0.3-3). Never below ``threshold_min``.
+* ``original``: the rule of the original implementation (Encog's original NEAT speciation):
+  the distance is ``E + D + 0.4 * mean |dw|`` over connection genes aligned by innovation
+  number, on raw weights, not normalised by size (``original_distance``), plus for genomes with
+  sensor genes (NEAT-M) their sensor term; before genomes are assigned, the threshold moves by
+  ``threshold_step`` (0.01, additive): up when the previous generation had more than
+  ``max_species`` species (40 in SO, the population in MO), down when fewer than
+  ``min_species`` (2); it starts at ``compatibility_threshold`` (1.0).
+* ``fixed``: neat-python's behaviour (the threshold never moves).
+
+The threshold and the species count of every generation are in ``history`` (and the run's
+statistics, ``threshold`` and ``species``). Keys and defaults: ``compatibility_threshold``
+(the start), ``species_mode = adaptive``, ``target_species = 0.1`` (a count, or a fraction of
+the population: 15 at N = 150), ``threshold_step = 0.1``,
+``threshold_min = 0.01``, ``max_species = 40``, ``min_species = 2`` (the last two only for
+``original``).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import neat
+from neat.config import ConfigParameter, DefaultClassConfig
+
+MODES = ("adaptive", "original", "fixed")
+SECTION = "GatheringSpeciesSet"
+
+#: Encog's coefficients of excess genes, disjoint genes and the mean weight difference.
+ORIGINAL_COEFFICIENTS = (1.0, 1.0, 0.4)
+
+
+def original_distance(a: Any, b: Any, coefficients: tuple[float, float, float] = ORIGINAL_COEFFICIENTS) -> float:
+    """Original NEAT distance of two genomes' connection genes, aligned by innovation number.
+
+    Genes of one genome with an innovation number above the other's largest are *excess*,
+    the other unmatched ones *disjoint*; matching genes contribute ``|w_a - w_b|`` to the mean
+    weight difference. Raw counts and raw weights: no normalisation by genome size.
+    """
+    ca = {_innovation(g): g.weight for g in a.connections.values()}
+    cb = {_innovation(g): g.weight for g in b.connections.values()}
+    if not ca and not cb:
+        return 0.0
+    top_a, top_b = max(ca, default=-1), max(cb, default=-1)
+    excess = disjoint = 0
+    for keys, top_other in ((ca.keys() - cb.keys(), top_b), (cb.keys() - ca.keys(), top_a)):
+        for k in keys:
+            if k > top_other:
+                excess += 1
+            else:
+                disjoint += 1
+    common = ca.keys() & cb.keys()
+    mean_dw = sum(abs(ca[k] - cb[k]) for k in common) / len(common) if common else 0.0
+    c_excess, c_disjoint, c_weight = coefficients
+    return c_excess * excess + c_disjoint * disjoint + c_weight * mean_dw
+
+
+def _innovation(gene: Any) -> Any:
+    innovation = getattr(gene, "innovation", None)
+    return gene.key if innovation is None else innovation
+
+
+#: Encog's rule as the original implementation set it: start, step, fewest species; the most
+#: species is 40 in single-objective runs and the population size in multi-objective ones.
+ORIGINAL_RULE = {"compatibility_threshold": 1.0, "threshold_step": 0.01, "min_species": 2, "max_species_so": 40}
+
+
+def use_original_rule(config: SpeciesSetConfig, multi_objective: bool, population: int) -> None:
+    """Set a species set config to the original implementation's rule (``species_mode = original``)."""
+    config.species_mode = "original"
+    config.compatibility_threshold = ORIGINAL_RULE["compatibility_threshold"]
+    config.threshold_step = ORIGINAL_RULE["threshold_step"]
+    config.min_species = ORIGINAL_RULE["min_species"]
+    config.max_species = population if multi_objective else ORIGINAL_RULE["max_species_so"]
+
+
+def adapted_threshold(threshold: float, count: int, target: int, step: float, minimum: float,
+                      new_species: bool = True) -> float:
+    """The adaptive rule (see the module docstring): the threshold for the next speciation."""
+    if count > target and new_species:
+        return threshold * (1.0 + step)
+    if count < target:
+        return max(minimum, threshold * (1.0 - step * (target - count) / target))
+    return threshold
+
+
+TARGET_ALLOWED = "a count (an integer >= 1, at most the population) or a fraction of the population in (0, 1)"
+
+
+def target_count(setting: str | float, population: int | None) -> int:
+    """The species count a ``target_species`` setting asks for in a population of ``population``:
+    an integer >= 1 is a count, a number in (0, 1) a fraction (rounded, at least 1).
+    ``ValueError`` for anything else, or a count above the population."""
+    try:
+        value = float(setting)
+    except (TypeError, ValueError):
+        raise ValueError(f"target_species = {setting}; allowed: {TARGET_ALLOWED}") from None
+    if 0.0 < value < 1.0:
+        return max(1, round(value * population)) if population is not None else 1
+    if not (value >= 1.0 and value == int(value)) or (population is not None and value > population):
+        raise ValueError(f"target_species = {setting}; allowed: {TARGET_ALLOWED}"
+                         + (f" ({population})" if population is not None else ""))
+    return int(value)
+
+
+class SpeciesSetConfig(DefaultClassConfig):
+    """The ``[GatheringSpeciesSet]`` section, checked; errors name the section and key."""
+
+    def __init__(self, param_dict: dict[str, Any]) -> None:
+        super().__init__(param_dict, [
+            ConfigParameter("compatibility_threshold", float),
+            ConfigParameter("species_mode", str, "adaptive"),
+            ConfigParameter("target_species", str, "0.1"),
+            ConfigParameter("threshold_step", float, 0.1),
+            ConfigParameter("threshold_min", float, 0.01),
+            ConfigParameter("max_species", int, 40),
+            ConfigParameter("min_species", int, 2),
+        ])
+        problems = []
+        if self.species_mode not in MODES:
+            problems.append(("species_mode", self.species_mode, " / ".join(MODES)))
+        if not 0.0 < self.compatibility_threshold < math.inf:
+            problems.append(("compatibility_threshold", self.compatibility_threshold, "a number > 0"))
+        if not 0.0 < self.threshold_step < math.inf:
+            problems.append(("threshold_step", self.threshold_step, "a number > 0"))
+        if not 0.0 < self.threshold_min < math.inf:
+            problems.append(("threshold_min", self.threshold_min, "a number > 0"))
+        try:
+            target_count(self.target_species, None)
+        except ValueError:
+            problems.append(("target_species", self.target_species, TARGET_ALLOWED))
+        if self.min_species < 1 or self.max_species < self.min_species:
+            problems.append(("max_species", self.max_species, f"an integer >= min_species ({self.min_species}) >= 1"))
+        if problems:
+            key, value, allowed = problems[0]
+            raise ValueError(f"[{SECTION}] {key} = {value}; allowed: {allowed}")
+
+
+class GatheringSpeciesSet(neat.DefaultSpeciesSet):
+    """``DefaultSpeciesSet`` whose compatibility threshold moves (see the module docstring)."""
+
+    def __init__(self, config: SpeciesSetConfig, reporters: Any) -> None:
+        super().__init__(config, reporters)
+        self.threshold = float(config.compatibility_threshold)
+        self.history: list[tuple[int, float, int]] = []  # (generation, threshold used, species)
+
+    @classmethod
+    def parse_config(cls, param_dict: dict[str, Any]) -> SpeciesSetConfig:
+        return SpeciesSetConfig(param_dict)
+
+    def speciate(self, config: Any, population: dict[int, Any], generation: int) -> None:
+        cfg = self.species_set_config
+        if cfg.species_mode == "original" and self.history:
+            # Encog decides before assigning, from the number of species that survived
+            survivors = len(self.species)
+            if survivors > cfg.max_species:
+                self.threshold += cfg.threshold_step
+            elif survivors < cfg.min_species:
+                self.threshold = max(cfg.threshold_min, self.threshold - cfg.threshold_step)
+        used = self.threshold
+        before = set(self.species)
+        self._speciate_at(config, population, generation, used)
+        count = len(self.species)
+        self.history.append((int(generation), used, count))
+        if cfg.species_mode == "adaptive":
+            target = target_count(cfg.target_species, getattr(config, "pop_size", None) or len(population))
+            self.threshold = adapted_threshold(used, count, target, cfg.threshold_step,
+                                               cfg.threshold_min, new_species=bool(set(self.species) - before))
+
+    def speciate_pool(self, config: Any, population: dict[int, Any], generation: int) -> None:
+        """Speciate at the current threshold without a step or a record: NEAT-MODS speciates
+        its pool of parents and offspring before selection, and the generation's one step
+        comes with the speciation of the new offspring."""
+        self._speciate_at(config, population, generation, self.threshold)
+
+    def _speciate_at(self, config: Any, population: dict[int, Any], generation: int, threshold: float) -> None:
+        """neat-python's assignment (``DefaultSpeciesSet.speciate``: the same deterministic order)
+        at ``threshold``, with the mode's distance."""
+        original = self.species_set_config.species_mode == "original"
+        cache: dict[tuple[int, int], float] = {}
+
+        def distance(a: Any, b: Any) -> float:
+            key = (a.key, b.key) if a.key <= b.key else (b.key, a.key)
+            d = cache.get(key)
+            if d is None:
+                d = cache[key] = self._original(a, b, config) if original else a.distance(b, config.genome_config)
+            return d
+
+        unspeciated = sorted(population)
+        representatives: dict[int, int] = {}
+        members: dict[int, list[int]] = {}
+        for sid in sorted(self.species):
+            rep = self.species[sid].representative
+            new_rep = min((population[gid] for gid in unspeciated), key=lambda g: distance(rep, g))
+            representatives[sid], members[sid] = new_rep.key, [new_rep.key]
+            unspeciated.remove(new_rep.key)
+        for gid in unspeciated:
+            genome = population[gid]
+            close = [(distance(population[rid], genome), sid) for sid, rid in representatives.items()]
+            close = [c for c in close if c[0] < threshold]
+            if close:
+                members[min(close)[1]].append(gid)
+            else:
+                sid = next(self.indexer)
+                representatives[sid], members[sid] = gid, [gid]
+        self.genome_to_species = {}
+        for sid in sorted(representatives):
+            species = self.species.get(sid)
+            if species is None:
+                species = self.species[sid] = neat.species.Species(sid, generation)
+            for gid in members[sid]:
+                self.genome_to_species[gid] = sid
+            species.update(population[representatives[sid]], {gid: population[gid] for gid in members[sid]})
+        # species that found no member are gone (neat-python drops them the same way)
+        for sid in [sid for sid in self.species if sid not in representatives]:
+            del self.species[sid]
+
+    @staticmethod
+    def _original(a: Any, b: Any, config: Any) -> float:
+        d = original_distance(a, b)
+        sensor_term = getattr(a, "sensor_distance", None)  # NEAT-M's sensor genes
+        return d + sensor_term(b, config.genome_config) if sensor_term is not None else d
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        super().__setstate__(state)
+        self.__dict__.setdefault("threshold", float(self.species_set_config.compatibility_threshold))
+        self.__dict__.setdefault("history", [])
+
+
+__all__ = ["GatheringSpeciesSet", "MODES", "ORIGINAL_COEFFICIENTS", "ORIGINAL_RULE", "use_original_rule", "SECTION", "SpeciesSetConfig",
+           "original_distance", "target_count"]
