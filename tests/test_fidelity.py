@@ -66,7 +66,6 @@ def test_shipped_neat_m_sensor_defaults():
     # the original's sensor operators, read from the shipped section (not class defaults)
     assert (gc.sensor_add_prob, gc.sensor_angle_mutate_prob, gc.sensor_reach_mutate_prob) == (0.07, 0.1, 0.07)
     assert gc.sensor_types == ["infrared", "ultrasonic", "colour", "camera", "bottom"]
-    assert gc.sensor_compatibility_coefficient > load(NEATMGenome).species_set_config.compatibility_threshold
 
 
 # ---------------------------------------------------------------- shared breeding

@@ -43,15 +43,9 @@ HAND_WORLD = dict(environment=1, arena_width=6.0, arena_height=6.0, zone_width=6
 
 def hand_cppn():
     """(config, genome): a hand-built CPPN, both wheels forward, the right one faster (x2 link)."""
-    import neat
-    from neat.innovation import InnovationTracker
-    from test_substrate import BIAS, CFG, X2, cppn
+    from test_substrate import BIAS, X2, cppn, cppn_config
 
-    from evolution.encodings.genome import CPPNGenome
-    from evolution.reproduction.breeding import NEATReproduction
-
-    config = neat.Config(CPPNGenome, NEATReproduction, neat.DefaultSpeciesSet, neat.DefaultStagnation, str(CFG))
-    config.genome_config.innovation_tracker = InnovationTracker()
+    config = cppn_config()
     return config, cppn(config, {(X2, BIAS): 1.0}, biases={BIAS: 0.3})
 
 

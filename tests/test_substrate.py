@@ -21,11 +21,16 @@ X1, Y1, X2, Y2 = -1, -2, -3, -4            # neat-python input keys
 WEIGHT, FOV, ORIENT, RANGE, TYPE, BIAS = range(6)
 
 
-@pytest.fixture(scope="module")
-def config():
+def cppn_config():
+    """The shipped HyperNEAT-M neat config, ready to build genomes by hand."""
     cfg = neat.Config(CPPNGenome, NEATReproduction, GatheringSpeciesSet, neat.DefaultStagnation, str(CFG))
     cfg.genome_config.innovation_tracker = InnovationTracker()
     return cfg
+
+
+@pytest.fixture(scope="module")
+def config():
+    return cppn_config()
 
 
 def cppn(config, links: dict[tuple[int, int], float], biases: dict[int, float] | None = None):
