@@ -362,11 +362,12 @@ class GatheringWorld:
     def weld(self, robot: int, block: int, slot: int, front: np.ndarray) -> None:
         """The pymunk side of an attachment already recorded in the arrays (``robot`` owns
         anchor ``slot`` of the block's sticky side): weld the robot to the block at its front
-        point, or, with ``pickup_positioning``, first snap it onto the anchor facing the block."""
+        point where it stands, or, with ``weld_seat`` (the default, as in the original), first seat
+        it with its front on the anchor, facing the block square to the sticky side."""
         cfg = self.config
         robot_body = self.robot_bodies[robot]
         block_body = self.block_bodies[block]
-        if cfg.pickup_positioning:
+        if cfg.weld_seat:
             side = int(self.block_sticky_side[block])
             point = self.anchor_points(block, side)[slot]
             normal_angle = self.block_angle[block] + math.atan2(*_SIDE_NORMALS[side][::-1])
@@ -385,7 +386,7 @@ class GatheringWorld:
         gear.collide_bodies = False
         self.space.add(pivot, gear)
         self._welds[robot] = (pivot, gear)
-        if cfg.pickup_positioning:
+        if cfg.weld_seat:
             self.read_state()
 
     def unweld(self, robot: int) -> None:

@@ -175,10 +175,10 @@ def _episode(kernel: str, steps: int, morphology: Morphology, seed: int, **world
 @pytest.mark.parametrize("world", [
     dict(SMALL),
     dict(SMALL, collision_avoidance=True),
-    dict(SMALL, pickup_positioning=True),
+    dict(SMALL, weld_seat=False),
     dict(SMALL, ir_response="gamma", physics_substeps=2),
     dict(environment=3, num_robots=20),
-], ids=["small", "avoidance", "positioning", "gamma-substeps", "env3"])
+], ids=["small", "avoidance", "weld-in-place", "gamma-substeps", "env3"])
 def test_whole_episodes_are_identical_on_both_kernels(world):
     steps = 400
     attached = gathered = shared = False

@@ -209,14 +209,45 @@ def test_collision_avoidance_turns_away_from_a_wall():
     assert abs(angle_on - math.pi / 2) > 0.5 and y_on < 39.8                     # turned away in time
 
 
-def test_pickup_positioning_snaps_onto_the_anchor():
-    sim = one_block_world(0, 1, pickup_positioning=True)
+def test_weld_seat_puts_the_robot_on_the_anchor():
+    sim = one_block_world(0, 1)                       # the default: the weld seats the robot
     w, cfg = sim.world, sim.config
+    assert cfg.weld_seat
     w.place_block(0, 20.0, 30.0, 0.0)
     # Slightly off-centre and skewed, touching the north face (y = 30.2).
     w.place_robot(0, 20.03, 30.2 + cfg.robot_radius + 0.01, -math.pi / 2 + 0.2)
     sim.step(np.zeros((1, 2)))
-    assert w.robot_attached[0] == 0
-    # Snapped: facing south (onto the side's normal), centred on the single anchor (x = 20).
+    assert w.robot_attached[0] == 0 and w.block_sticky_side[0] >= 0
+    # Seated: facing south (onto the side's inward normal), its front on the single anchor (20, 30.2).
     assert w.robot_angle[0] == pytest.approx(-math.pi / 2, abs=0.05)
-    assert w.robot_pos[0, 0] == pytest.approx(20.0, abs=0.02)
+    front = w.robot_pos[0] + cfg.robot_radius * np.array([math.cos(w.robot_angle[0]), math.sin(w.robot_angle[0])])
+    np.testing.assert_allclose(front, [20.0, 30.2], atol=0.02)
+
+
+def test_weld_seat_puts_two_robots_on_their_own_anchors_facing_the_same_way():
+    """A medium block (two anchors per side, at -1/2 and +1/2 of its half size): robots that
+    grip skewed in different directions end up side by side, both facing the block square."""
+    sim = one_block_world(1, 2)
+    w, cfg = sim.world, sim.config
+    w.place_block(0, 20.0, 30.0, 0.0)
+    half = w.block_half[0]
+    top = 30.0 + half
+    w.place_robot(0, 19.85, top + cfg.robot_radius + 0.01, -math.pi / 2 + 0.35)
+    w.place_robot(1, 20.15, top + cfg.robot_radius + 0.01, -math.pi / 2 - 0.3)
+    sim.step(np.zeros((2, 2)))
+    assert list(w.robot_attached) == [0, 0]
+    for robot, x in ((0, 20.0 - half / 2), (1, 20.0 + half / 2)):
+        assert w.robot_angle[robot] == pytest.approx(-math.pi / 2, abs=0.05)
+        heading = np.array([math.cos(w.robot_angle[robot]), math.sin(w.robot_angle[robot])])
+        np.testing.assert_allclose(w.robot_pos[robot] + cfg.robot_radius * heading, [x, top], atol=0.02)
+
+
+def test_weld_in_place_keeps_the_robots_heading():
+    sim = one_block_world(0, 1, weld_seat=False)
+    w, cfg = sim.world, sim.config
+    w.place_block(0, 20.0, 30.0, 0.0)
+    w.place_robot(0, 20.03, 30.2 + cfg.robot_radius + 0.01, -math.pi / 2 + 0.2)
+    sim.step(np.zeros((1, 2)))
+    assert w.robot_attached[0] == 0
+    assert w.robot_angle[0] == pytest.approx(-math.pi / 2 + 0.2, abs=0.02)   # welded skewed, where it stood
+

@@ -72,19 +72,20 @@ def test_sensor_type_bands_and_bounds(config):
     _, morph = decode(genome, config, Substrate(bottom_on_node0=False))
     assert len(morph) == 10
     for s in morph:
-        spec = SENSOR_TYPES["infrared"]                 # band 0 of (infrared, ultrasonic, colour, camera)
+        spec = SENSOR_TYPES["infrared"]                 # band 0 of (infrared, ultrasonic, camera, colour)
         assert s.type == "infrared"
         assert s.range == pytest.approx(spec.range_max)
         assert s.fov == pytest.approx(spec.fov_max)
         assert s.orientation == pytest.approx(math.pi / 2)
     genome = cppn(config, {}, biases={WEIGHT: 1.0, FOV: -1.0, ORIENT: -1.0, RANGE: -1.0, TYPE: 0.99})
     _, morph = decode(genome, config, Substrate(bottom_on_node0=False))
-    spec = SENSOR_TYPES["camera"]                      # type 0.99 -> last band
-    assert {s.type for s in morph} == {"camera"}
+    spec = SENSOR_TYPES["colour"]                      # type 0.99 -> last band
+    assert {s.type for s in morph} == {"colour"}
     assert morph[0].fov == pytest.approx(spec.fov_min)
     assert morph[0].orientation == pytest.approx(-math.pi / 2)
     assert morph[0].range == pytest.approx(0.001 * spec.range_max)
-    for value, kind in ((-0.6, "infrared"), (-0.4, "ultrasonic"), (0.1, "colour"), (0.6, "camera")):
+    # the original's order along the type output: infrared, ultrasonic, camera, colour
+    for value, kind in ((-0.6, "infrared"), (-0.4, "ultrasonic"), (0.1, "camera"), (0.6, "colour")):
         genome = cppn(config, {}, biases={WEIGHT: 1.0, TYPE: value})
         _, morph = decode(genome, config, Substrate(bottom_on_node0=False))
         assert morph[0].type == kind, value
@@ -92,10 +93,10 @@ def test_sensor_type_bands_and_bounds(config):
 
 def test_strongest_link_chooses_the_sensor(config):
     # weight = 0.5 + 0.4 * x2: right output (x2 = +0.5) is stronger (0.7 > 0.3);
-    # type = 0.7 * x2 -> right: 0.35 -> colour band [0, 0.5); left: -0.35 -> ultrasonic.
+    # type = 0.7 * x2 -> right: 0.35 -> camera band [0, 0.5); left: -0.35 -> ultrasonic.
     genome = cppn(config, {(X2, WEIGHT): 0.4, (X2, TYPE): 0.7}, biases={WEIGHT: 0.5})
     _, morph = decode(genome, config, Substrate(bottom_on_node0=False))
-    assert {s.type for s in morph} == {"colour"}
+    assert {s.type for s in morph} == {"camera"}
 
 
 @pytest.mark.parametrize("slope, kind, fov_sign", [(-1.2, "ultrasonic", -1), (1.2, "colour", 1)])

@@ -18,7 +18,7 @@ target); every output is clipped to [-1, 1]. Decoding:
   it goes through the same threshold and rescaling as a link weight, so |b| <= 0.2 gives 0;
 * each input node's **sensor** comes from its outgoing link with the highest *signed* CPPN
   weight: type from the ``type`` output split into ``len(sensor_types)`` equal bands over
-  [-1, 1] (infrared, ultrasonic, colour, camera); fov and range mapped linearly from
+  [-1, 1] (infrared, ultrasonic, camera, colour: the original's order); fov and range mapped linearly from
   [-1, 1] onto the type's bounds (range onto [``range_floor`` * max, max] since 0 is
   excluded), orientation onto [-pi/2, pi/2]; bearing = atan2(y, x) of the input node;
 * an input node with no outgoing link has **no sensor** and no controller input;
@@ -57,7 +57,7 @@ class Substrate:
     weight_threshold: float = 0.2
     max_weight: float = 5.0
     bottom_on_node0: bool = True
-    sensor_types: tuple[str, ...] = ("infrared", "ultrasonic", "colour", "camera")
+    sensor_types: tuple[str, ...] = ("infrared", "ultrasonic", "camera", "colour")  # the original's order
     hidden_nodes: int = 0
     hidden_radius: float = 0.75
     range_floor: float = 0.001
