@@ -290,7 +290,7 @@ def test_rl_ppo_example_refuses_bad_input_in_one_line(tmp_path, capsys, argv, ne
 
 
 def test_vecenv_worlds_ending_at_different_steps():
-    """World 1 gathers its block at step 104 and world 0 runs to the step limit (150): each end
+    """World 1 gathers its block at step 121 and world 0 runs to the step limit (150): each end
     reports done for its own N sub-environments only, with its own terminal observation, ft and
     return, and that world's return starts again from 0 (the other's does not)."""
     from evolution.policies.scripted import WanderTeam
@@ -300,15 +300,15 @@ def test_vecenv_worlds_ending_at_different_steps():
     options = dict(environment=None, arena_width=6.0, arena_height=6.0, zone_width=6.0, zone_depth=2.0,
                    block_counts=(1, 0, 0), num_robots=8, max_cycles=150, reward="shaped")
     n = 8
-    venv = GatheringVecEnv(2, seed=20, **options)
-    draws = iter(int(s) for s in np.random.default_rng(20).integers(0, SEED_LIMIT, 8))
+    venv = GatheringVecEnv(2, seed=16, **options)
+    draws = iter(int(s) for s in np.random.default_rng(16).integers(0, SEED_LIMIT, 8))
     reference = VectorSimulation(2, **options)
     ref_obs = reference.reset([next(draws), next(draws)])
     obs = venv.reset()
     team = WanderTeam(venv.sim.morphology, seed=0)
     returns = np.zeros(2)
     ends = []
-    for t in range(260):
+    for t in range(280):
         actions = team.act(obs).astype(np.float32)
         obs, rewards, dones, infos = venv.step(actions)
         ref_obs, ref_team, terminated, truncated = reference.step(actions.reshape(2, n, 2).astype(np.float64))
@@ -316,6 +316,8 @@ def test_vecenv_worlds_ending_at_different_steps():
         ended = terminated | truncated
         np.testing.assert_array_equal(dones, np.repeat(ended, n))        # sub-env k is world k // n
         ft = reference.task_performance()
+        if ended.any() and not ends:
+            assert np.all(returns[~ended] != 0.0)   # the running world has a return a wrong reset would lose
         for w in range(2):
             block = slice(w * n, (w + 1) * n)
             if not ended[w]:
@@ -323,7 +325,6 @@ def test_vecenv_worlds_ending_at_different_steps():
                 np.testing.assert_array_equal(obs[block], ref_obs[w])
                 continue
             ends.append((t, w, bool(terminated[w])))
-            assert returns[w] != 0.0                                       # (so a missed reset shows)
             for i, info in enumerate(infos[block]):
                 np.testing.assert_array_equal(info["terminal_observation"], ref_obs[w, i])
                 assert info["task_performance"] == ft[w]
@@ -331,4 +332,6 @@ def test_vecenv_worlds_ending_at_different_steps():
                 assert info["TimeLimit.truncated"] is bool(truncated[w] and not terminated[w])
             np.testing.assert_array_equal(obs[block], reference.reset_world(w, next(draws)))  # next seed
             returns[w] = 0.0
-    assert ends == [(103, 1, True), (149, 0, False), (253, 1, False)]
+    # (the seed was picked for this pattern; if a physics change alters it, pick another seed
+    # whose worlds end at different steps, one by gathering and one by the step limit)
+    assert ends == [(120, 1, True), (149, 0, False), (270, 1, False)]

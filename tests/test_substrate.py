@@ -99,12 +99,12 @@ def test_strongest_link_chooses_the_sensor(config):
     assert {s.type for s in morph} == {"camera"}
 
 
-@pytest.mark.parametrize("slope, kind, fov_sign", [(-1.2, "ultrasonic", -1), (1.2, "colour", 1)])
+@pytest.mark.parametrize("slope, kind, fov_sign", [(-1.2, "ultrasonic", -1), (1.2, "camera", 1)])
 def test_sensor_comes_from_the_highest_signed_weight_not_the_largest_magnitude(config, slope, kind, fov_sign):
     # weight = -0.3 + slope * x2: with slope -1.2 the left link (x2 = -0.5) has +0.3 and the right
     # (x2 = +0.5) -0.9; both exist (|w| > 0.2) and the signed maximum is the left one, though the
     # right one is larger in magnitude. slope +1.2 mirrors it. type = 0.7 * x2: -0.35 on the left
-    # (ultrasonic band), +0.35 on the right (colour); fov = 0.8 * x2 likewise from the same link.
+    # (ultrasonic band), +0.35 on the right (camera); fov = 0.8 * x2 likewise from the same link.
     genome = cppn(config, {(X2, WEIGHT): slope, (X2, TYPE): 0.7, (X2, FOV): 0.8}, biases={WEIGHT: -0.3})
     controller, morph = decode(genome, config, Substrate(bottom_on_node0=False))
     assert len(morph) == 10 and controller.num_links == 20           # every input links to both outputs
