@@ -251,3 +251,24 @@ def test_weight_operator_resets_and_perturbs_at_the_configured_rates():
             assert abs(share[k] - p) < 5 * math.sqrt(p * (1 - p) / draws), (k, share)
         sd = float(np.std(steps))
         assert abs(sd - gc.weight_mutate_power) < 0.05 * gc.weight_mutate_power   # perturbation size
+
+
+def test_neat_python_variation_applies_each_sensor_operator_once_with_its_probability():
+    """variation = neat_python: neat-python's mutate() (here: delete one link), then each of the
+    four sensor operators with its own probability (here: add a sensor, certainly)."""
+    config = load(NEATMGenome, "neat_m.neat.cfg")
+    gc = config.genome_config
+    gc.variation = "neat_python"
+    gc.node_add_prob = gc.node_delete_prob = gc.conn_add_prob = 0.0
+    gc.conn_delete_prob = 1.0
+    gc.weight_mutate_rate = gc.bias_mutate_rate = gc.weight_replace_rate = gc.bias_replace_rate = 0.0
+    gc.sensor_add_prob, gc.sensor_remove_prob = 1.0, 0.0
+    gc.sensor_angle_mutate_prob = gc.sensor_reach_mutate_prob = 0.0
+    random.seed(15)
+    for _ in range(20):
+        genome = neat_m_genome(config, {0: ("bottom", 0.0, 0.0, 0.0, 0.0), 1: ("camera", 0.5, 0.1, 12.0, 1.0)})
+        links, before = len(genome.connections), snapshot(genome)
+        genome.mutate(gc)
+        assert len(genome.connections) == links - 1                 # neat-python's one deletion, no more
+        after = snapshot(genome)
+        assert len(after) == 3 and {s: after[s] for s in before} == before   # one sensor added, none moved
