@@ -152,3 +152,12 @@ def test_per_process_worlds_are_keyed_by_the_whole_world_configuration():
     evaluation._SIM_CACHE.clear()
     cold = evaluate(genome, config, dict(HAND_WORLD, max_cycles=60), trials=5, seed=3, generation=1)
     assert warm.trial_ft == cold.trial_ft and warm.steps == cold.steps == 5 * 60
+
+
+def test_a_failed_evaluation_has_the_worst_objectives_and_keeps_its_error():
+    ev = Evaluation.failure("worker died")
+    assert ev.objectives(("task", "morphology", "controller")) == (0.0, 0.0, 0.0)   # every minimum
+    assert ev.failed and ev.error == "worker died" and ev.trial_ft == [] and ev.steps == 0
+    assert ev.sensors == sensor_statistics(Morphology()) and ev.sensors["num_sensors"] == 0.0
+    assert Evaluation(**ev.to_dict()) == ev
+    assert not Evaluation(task=1.0, morphology=2.0, controller=3.0).failed
