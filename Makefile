@@ -1,13 +1,14 @@
 # make test   : create .venv if missing, install the project with its test extras, run the fast tests
 # make demo   : set up and run the main job
 # make bench  : print the environment and generation benchmarks
+# make bench-learning : the learning benchmark (S1 and M1 at a mid budget, held-out comparison)
 # make mutation: mutation testing (mutmut) of the study-critical modules; survivors -> mutation-survivors.txt
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test test-slow demo bench lint clean mutation
+.PHONY: test test-slow demo bench bench-learning lint clean mutation
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -36,12 +37,18 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_env.py
 	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_generation.py
 
+# Does evolution learn? S1 and M1 at a mid budget (about an hour on 2 idle cores), then the
+# champions against scripted teams on held-out layouts (docs/evidence.md). Resumable:
+# make bench-learning ARGS=--resume
+bench-learning: $(STAMP)
+	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_learning.py --out runs/bench-learning $(ARGS)
+
 # Mutation testing ([tool.mutmut] in pyproject.toml; docs/testing.md). CPU-heavy: restrict it with
 # MUTANTS, mutmut's name globs, e.g. make mutation MUTANTS='evolution.reproduction.pareto*'.
 MUTANTS ?=
 mutation: $(STAMP)
 	$(PY) -m pip install --quiet "mutmut>=3.8,<4"
-	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy nice -n 15 $(VENV)/bin/mutmut run --max-children 2 $(MUTANTS) || true
+	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy nice -n 15 $(VENV)/bin/mutmut run --max-children 2 $(MUTANTS)
 	$(VENV)/bin/mutmut results > mutation-survivors.txt
 	@echo "survivors: $$(grep -c ': survived' mutation-survivors.txt) (mutation-survivors.txt; 'mutmut show NAME' for one)"
 

@@ -64,6 +64,16 @@ LIMITS: dict[str, tuple[int, float]] = {
 }
 
 
+def _species_modes() -> tuple[str, ...]:
+    from evolution.reproduction.species import MODES
+
+    return MODES
+
+
+#: Keys whose value is one of a few names.
+CHOICES = {"method": lambda: METHODS, "speciation": _species_modes}
+
+
 class ExperimentError(ValueError):
     """A broken or inconsistent experiment file or override."""
 
@@ -278,9 +288,9 @@ def _check_key(source: str, key: str, value: Any) -> Any:
         if not isinstance(value, str) or not value or any(c in value for c in "/\\"):
             raise ExperimentError(f"{where}={value!r} must be a non-empty name without slashes")
         return value
-    if key == "method":
-        if value not in METHODS:
-            raise ExperimentError(f"{where}={value!r}; allowed: {list(METHODS)}")
+    if key in CHOICES:
+        if value not in CHOICES[key]():
+            raise ExperimentError(f"{where}={value!r}; allowed: {list(CHOICES[key]())}")
         return value
     if key == "objectives":
         if isinstance(value, str):
@@ -301,12 +311,6 @@ def _check_key(source: str, key: str, value: Any) -> Any:
     if key == "convergence_stop":
         if not isinstance(value, bool):
             raise ExperimentError(f"{where}={value!r} must be true or false")
-        return value
-    if key == "speciation":
-        from evolution.reproduction.species import MODES
-
-        if value not in MODES:
-            raise ExperimentError(f"{where}={value!r}; allowed: {list(MODES)}")
         return value
     if key == "neat_config":
         if not isinstance(value, (str, Path)):

@@ -14,9 +14,10 @@ import numpy as np  # noqa: E402
 
 
 def plot_run(records: Sequence[dict[str, Any]], path: Path, title: str = "") -> Path:
-    """Two panels: best/mean (+- std) ft; mean morphological simplicity and sensor count."""
+    """Three panels: best/mean (+- std) ft; mean morphological simplicity and sensor count;
+    species and the compatibility threshold that formed them."""
     gen = np.array([r["generation"] for r in records])
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.8), constrained_layout=True)
+    fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(14, 3.8), constrained_layout=True)
     mean = np.array([r["task_mean"] for r in records])
     std = np.array([r["task_std"] for r in records])
     ax1.plot(gen, [r["task_best"] for r in records], label="best ft", color="tab:red")
@@ -35,6 +36,19 @@ def plot_run(records: Sequence[dict[str, Any]], path: Path, title: str = "") -> 
     twin.set_ylim(0, 10)
     lines = ax2.get_lines() + twin.get_lines()
     ax2.legend(lines, [ln.get_label() for ln in lines], loc="lower right", fontsize=8)
+    ax3.plot(gen, [r.get("species", np.nan) for r in records], color="tab:purple", label="species")
+    ax3.set_xlabel("generation")
+    ax3.set_ylabel("species")
+    ax3.set_ylim(0, None)
+    thresholds = [r.get("threshold") for r in records]
+    lines3 = ax3.get_lines()
+    if any(t is not None for t in thresholds):
+        twin3 = ax3.twinx()
+        twin3.plot(gen, [np.nan if t is None else t for t in thresholds], color="tab:olive", ls="--",
+                   label="compatibility threshold")
+        twin3.set_ylabel("compatibility threshold")
+        lines3 = lines3 + twin3.get_lines()
+    ax3.legend(lines3, [ln.get_label() for ln in lines3], loc="upper right", fontsize=8)
     if title:
         fig.suptitle(title)
     path = Path(path)
