@@ -27,8 +27,12 @@ def test_task_performance_by_hand():
     assert task_performance(20, 20, 2500, 10_000) == pytest.approx(100 + 20 * 0.75)
     assert task_performance(20, 20, 10_000, 10_000) == pytest.approx(100.0)
     assert task_performance(20, 20, 5000, 10_000, time_bonus=10) == pytest.approx(105.0)
+    assert task_performance(1, 1, 50, 100) == pytest.approx(110.0)                # one small block, in half the steps
+    assert task_performance(0.25, 0.5, 100, 100) == pytest.approx(50.0)           # any positive total value
     with pytest.raises(ValueError):
         task_performance(1, 0, 1, 1)
+    with pytest.raises(ValueError):
+        task_performance(0, -1, 1, 1)
 
 
 def make_env(**kw):
