@@ -2,12 +2,13 @@
 # make demo   : set up and run the main job
 # make bench  : print the environment and generation benchmarks
 # make bench-learning : the learning benchmark (S1 and M1 at a mid budget, held-out comparison)
+# make mutation: mutation testing (mutmut) of the study-critical modules; survivors -> mutation-survivors.txt
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: test test-slow demo bench bench-learning lint clean
+.PHONY: test test-slow demo bench bench-learning lint clean mutation
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -42,8 +43,17 @@ bench: $(STAMP)
 bench-learning: $(STAMP)
 	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_learning.py --out runs/bench-learning $(ARGS)
 
+# Mutation testing ([tool.mutmut] in pyproject.toml; docs/testing.md). CPU-heavy: restrict it with
+# MUTANTS, mutmut's name globs, e.g. make mutation MUTANTS='evolution.reproduction.pareto*'.
+MUTANTS ?=
+mutation: $(STAMP)
+	$(PY) -m pip install --quiet "mutmut>=3.8,<4"
+	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy nice -n 15 $(VENV)/bin/mutmut run --max-children 2 $(MUTANTS)
+	$(VENV)/bin/mutmut results > mutation-survivors.txt
+	@echo "survivors: $$(grep -c ': survived' mutation-survivors.txt) (mutation-survivors.txt; 'mutmut show NAME' for one)"
+
 lint: $(STAMP)
 	$(PY) -m ruff check .
 
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) out .pytest_cache mutants mutation-survivors.txt
