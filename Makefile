@@ -5,6 +5,7 @@
 # make bench          : print the environment and generation benchmarks
 # make bench-learning : the learning benchmark (S1 and M1 at a mid budget, held-out comparison)
 # make docs-images    : regenerate every figure of docs/ (examples/docs_images.py)
+# make mutation       : mutation testing (mutmut) of the study-critical modules; survivors -> mutation-survivors.txt
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
@@ -13,7 +14,7 @@ CORE   := $(VENV)/.installed-core
 ALL    := $(VENV)/.installed-all
 PIP    := $(PY) -m pip install --quiet --disable-pip-version-check
 
-.PHONY: test test-slow demo bench bench-learning lint docs-images clean
+.PHONY: test test-slow demo bench bench-learning lint docs-images clean mutation
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -51,6 +52,15 @@ bench: $(CORE)
 bench-learning: $(CORE)
 	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_learning.py --out runs/bench-learning $(ARGS)
 
+# Mutation testing ([tool.mutmut] in pyproject.toml; docs/testing.md). CPU-heavy: restrict it with
+# MUTANTS, mutmut's name globs, e.g. make mutation MUTANTS='evolution.reproduction.pareto*'.
+MUTANTS ?=
+mutation: $(ALL)
+	$(PY) -m pip install --quiet "mutmut>=3.8,<4"
+	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy nice -n 15 $(VENV)/bin/mutmut run --max-children 2 $(MUTANTS)
+	$(VENV)/bin/mutmut results > mutation-survivors.txt
+	@echo "survivors: $$(grep -c ': survived' mutation-survivors.txt) (mutation-survivors.txt; 'mutmut show NAME' for one)"
+
 lint: $(ALL)
 	$(PY) -m ruff check .
 
@@ -58,4 +68,4 @@ docs-images: $(CORE)
 	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy $(PY) examples/docs_images.py
 
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) out .pytest_cache mutants mutation-survivors.txt

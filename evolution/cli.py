@@ -20,8 +20,12 @@ from evolution.run.experiment import (
     neat_config_names,
     preset_description,
     preset_names,
-    preset_path,
+    preset_text,
+    protocol_preset_description,
+    protocol_preset_names,
+    resolve_preset,
 )
+from evolution.run.protocol import DESCRIPTIONS, PROTOCOLS
 
 MAX_WORKERS = max(4, 4 * (os.cpu_count() or 1))
 """Most evaluation processes ``--workers`` may ask for: four per core (each worker holds its own
@@ -29,13 +33,22 @@ environment, so more processes than cores only add memory)."""
 
 
 def _list_presets() -> int:
-    for name in preset_names() + neat_config_names():
+    print(f"# protocol \"paper\": {DESCRIPTIONS['paper']}")
+    for name in preset_names():
+        print(f"{name:22s} {preset_description(name)}")
+    for protocol in PROTOCOLS[1:]:
+        print(f"# protocol \"{protocol}\": {DESCRIPTIONS[protocol]}")
+        for name in protocol_preset_names():
+            if name.endswith(f"-{protocol}"):
+                print(f"{name:22s} {protocol_preset_description(name)}")
+    print("# neat-python configs")
+    for name in neat_config_names():
         print(f"{name:22s} {preset_description(name)}")
     return 0
 
 
 def _dump_preset(name: str) -> int:
-    sys.stdout.write(preset_path(name, neat_configs=True).read_text(encoding="utf-8"))
+    sys.stdout.write(preset_text(name))
     return 0
 
 
@@ -71,6 +84,9 @@ def evolve_main(argv: list[str] | None = None) -> int:
                         help="retries of a failing evaluation (default 2)")
     group = parser.add_argument_group("overrides of the experiment file")
     group.add_argument("--name", help="the run's name ([experiment] name; default run folder runs/<name>-seed<seed>)")
+    group.add_argument("--protocol", choices=PROTOCOLS,
+                       help="a named bundle of world and method options (docs/fidelity.md); "
+                            "'original' = the 2018 code behind the published figures")
     group.add_argument("--method", choices=METHODS, help="hyperneat-m (CPPN) or neat-m (direct encoding)")
     group.add_argument("--objectives", help="comma-separated, all maximised: task (ft), morphology (simplicity C), "
                                              "controller (100 - links); more than one = NEAT-MODS")
@@ -84,6 +100,9 @@ def evolve_main(argv: list[str] | None = None) -> int:
     group.add_argument("--steps", type=int, help="steps per trial (max_cycles)")
     group.add_argument("--robots", type=int, help="team size (num_robots)")
     args = parser.parse_args(argv)
+    if args.ray_address is not None and args.backend != "ray":
+        raise UsageError(f"--ray-address {args.ray_address}: only used with --backend ray (the backend is "
+                         f"{args.backend}); allowed: add --backend ray, or drop --ray-address")
     if args.list:
         return _list_presets()
     if args.dump is not None:
@@ -91,11 +110,17 @@ def evolve_main(argv: list[str] | None = None) -> int:
             return _dump_preset(args.dump)
         except ValueError as err:
             raise UsageError(f"--dump {err}") from None
+    preset_overrides: dict = {}
     if args.experiment is not None:
-        args.experiment = preset_path(args.experiment) if is_preset_name(args.experiment) else Path(args.experiment)
+        if is_preset_name(args.experiment):
+            args.experiment, preset_overrides = resolve_preset(args.experiment)
+        else:
+            args.experiment = Path(args.experiment)
 
     overrides = {
-        "name": args.name, "method": args.method, "seed": args.seed, "generations": args.generations,
+        **preset_overrides,
+        "protocol": args.protocol if args.protocol is not None else preset_overrides.get("protocol"),
+        "name": args.name if args.name is not None else preset_overrides.get("name"), "method": args.method, "seed": args.seed, "generations": args.generations,
         "population": args.population, "trials": args.trials,
         "objectives": [o.strip() for o in args.objectives.split(",")] if args.objectives is not None else None,
         "environment.environment": args.environment, "environment.max_cycles": args.steps,
@@ -194,6 +219,9 @@ def replay_main(argv: list[str] | None = None) -> int:
     if args.no_panel:
         render_options["panel"] = False
     check_output_file(args.out, (".gif", ".mp4"), "--out")
+    if args.png is not None and args.sensors_png is not None and args.png.resolve() == args.sensors_png.resolve():
+        raise UsageError(f"--sensors-png {args.sensors_png}: the same file as --png (one would overwrite the "
+                         "other); allowed: two different file names")
     for picture, flag in ((args.png, "--png"), (args.sensors_png, "--sensors-png")):
         if picture is not None:
             check_output_file(picture, (".png",), flag)

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from evolution.guard import ArgumentParser, check_output_dir, command, int_arg
+from evolution.guard import ArgumentParser, check_output_dir, command, int_arg, writing
 from evolution.policies import Policy, make_policy
 from evolution.run.experiment import LIMITS
 from gathering_env import WorldConfig, parallel_env
@@ -85,7 +85,7 @@ def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Pa
     check_output_dir(out, COMPARE_FILES)
     out.mkdir(parents=True, exist_ok=True)
     csv_path = out / "compare.csv"
-    with open(csv_path, "w", newline="") as f:
+    with writing(csv_path), open(csv_path, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
@@ -97,7 +97,8 @@ def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Pa
         lines.append(f"| {r['policy']} | {r['sensors']} | {r['ft_mean']:.2f}{se} | {r['small']:.1f} | "
                      f"{r['medium']:.1f} | {r['large']:.1f} | {r['finished']}/{r['episodes']} | {steps} |")
     md_path = out / "compare.md"
-    md_path.write_text(f"{title}\n\n" + "\n".join(lines) + "\n")
+    with writing(md_path):
+        md_path.write_text(f"{title}\n\n" + "\n".join(lines) + "\n")
     fig, ax = plt.subplots(figsize=(1.6 + 1.3 * len(rows), 3.6), constrained_layout=True)
     ax.bar(range(len(rows)), [r["ft_mean"] for r in rows], yerr=[r["ft_se"] or 0.0 for r in rows], capsize=4,
            color="tab:blue")
@@ -105,7 +106,8 @@ def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Pa
     ax.set_ylabel("task performance ft (mean ± standard error)")
     ax.set_title(title, fontsize=9)
     png_path = out / "compare.png"
-    fig.savefig(png_path, dpi=110)
+    with writing(png_path):
+        fig.savefig(png_path, dpi=110)
     plt.close(fig)
     return md_path, csv_path, png_path
 

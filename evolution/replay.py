@@ -10,7 +10,7 @@ import numpy as np
 
 from evolution.run.champion import Champion
 from gathering_env import parallel_env
-from gathering_env.render import RenderOptionError, film_strip, save_png, save_video, sensor_layout
+from gathering_env.render import RenderOptionError, VideoWriter, film_strip, save_png, sensor_layout
 
 
 def parse_steps(value: str | Sequence[int], max_cycles: int) -> list[int]:
@@ -39,6 +39,9 @@ def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
            sensors_png: Path | None = None) -> tuple[dict[str, Any], Path, int]:
     """Run one episode of the champion's team with rendering; returns (final info, video path, frames).
 
+    Frames are streamed to the video file as they are drawn (``VideoWriter``: memory does not
+    grow with the episode); the file appears only once complete, so a failure leaves none.
+
     Args:
         render_options: what the frames show (``gathering_env.render``: cones, view, size_px,
             trail, panel, min_robot_px).
@@ -60,9 +63,9 @@ def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
     if sensors_png is not None:
         title = f"{champion.experiment or 'champion'} ({champion.method}): sensors of every robot"
         save_png(sensor_layout(champion.morphology, title=title), sensors_png)
+    video = VideoWriter(out, fps=fps)  # checks the suffix and fps before the episode
     obs_dict, _ = env.reset(seed=seed, options={"morphology": champion.morphology})
     obs = np.stack([obs_dict[a] for a in env.possible_agents])
-    frames = [env.render()]
     panels: dict[int, np.ndarray] = {}
     captions: dict[int, str] = {}
 
@@ -71,27 +74,31 @@ def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
         panels[step] = env.render(panel=False)
         captions[step] = f"step {sim.steps}: value {sim.gathered_value:g} / {sim.total_value:g}"
 
-    if 0 in steps:
-        snap(0)
-    step = 0
-    while env.agents:
-        obs, _, terminated, truncated = env.step_batch(champion.controller.act(obs))
-        step += 1
-        if step % frame_every == 0 or terminated or truncated:
-            frames.append(env.render())
-        if step in steps:
-            snap(step)
-    for s in steps:                                  # the episode ended before these steps
-        if s not in panels:
-            snap(s)
+    with video:
+        last = env.render()
+        video.add(last)
+        if 0 in steps:
+            snap(0)
+        step = 0
+        while env.agents:
+            obs, _, terminated, truncated = env.step_batch(champion.controller.act(obs))
+            step += 1
+            if step % frame_every == 0 or terminated or truncated:
+                last = env.render()
+                video.add(last)
+            if step in steps:
+                snap(step)
+        for s in steps:                                  # the episode ended before these steps
+            if s not in panels:
+                snap(s)
     info = env.team_info()
     env.close()
     if png is not None:
         if steps:
             save_png(film_strip([panels[s] for s in steps], [captions[s] for s in steps]), png)
         else:
-            save_png(frames[-1], png)
-    return info, save_video(frames, out, fps=fps), len(frames)
+            save_png(last, png)
+    return info, Path(out), video.frames
 
 
 def unseen_note(champion: Champion, env_config: dict[str, Any], seed: int) -> str:

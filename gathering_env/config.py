@@ -33,6 +33,9 @@ REWARDS: tuple[str, str] = ("task", "shaped")
 #: Who receives which reward (``WorldConfig.reward_scope``).
 REWARD_SCOPES: tuple[str, str] = ("team", "local")
 
+#: Where the pickup box sits (``WorldConfig.pickup_box``).
+PICKUP_BOXES: tuple[str, str] = ("front", "centre")
+
 #: Names of the three block types, index = type id.
 BLOCK_TYPE_NAMES: tuple[str, str, str] = ("small", "medium", "large")
 
@@ -93,8 +96,14 @@ class WorldConfig:
 
     # --- heuristics ------------------------------------------------------------------
     pickup_heuristic: bool = True
+    pickup_box: str = "front"
+    """Where the pickup box lies: 'front' (the paper: just ahead of the rim, its near edge on
+    the rim) or 'centre' (the original code: centred on the robot's centre, so a block must
+    touch the robot's body to be gripped)."""
     pickup_box_width: float = 0.1
+    """Extent of the pickup box across the heading (units)."""
     pickup_box_depth: float = 0.2
+    """Extent of the pickup box along the heading (units)."""
     pickup_reach: float = 2.5
     """A robot attaches only within this many robot radii of a free anchor point."""
     weld_seat: bool = True
@@ -206,6 +215,8 @@ class WorldConfig:
                             ("collision_avoidance", self.collision_avoidance)):
             if not isinstance(value, bool):
                 raise ValueError(f"{name}={value!r} must be a bool (True or False)")
+        if self.pickup_box not in PICKUP_BOXES:
+            raise ValueError(f"pickup_box={self.pickup_box!r}; allowed: {', '.join(map(repr, PICKUP_BOXES))}")
         if self.ir_response not in ("linear", "gamma"):
             raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma'")
         if self.reward not in REWARDS:
@@ -228,6 +239,11 @@ class WorldConfig:
     def zone_centre(self) -> tuple[float, float]:
         x0, y0, x1, y1 = self.zone_rect
         return (0.5 * (x0 + x1), 0.5 * (y0 + y1))
+
+    @property
+    def pickup_box_offset(self) -> float:
+        """Distance from the robot's centre to the pickup box's centre, along the heading."""
+        return self.robot_radius + 0.5 * self.pickup_box_depth if self.pickup_box == "front" else 0.0
 
     @property
     def num_blocks(self) -> int:

@@ -260,20 +260,35 @@ BOTTOM_SENSOR_COST = 10.0
 """A bottom sensor subtracts a flat 10 from the complexity score (as in the original)."""
 
 
-def morphological_complexity(morphology: Morphology | Iterable[SensorSpec | Mapping[str, Any]]) -> float:
+COMPLEXITY_FORMULAS: tuple[str, str] = ("paper", "original")
+"""Versions of eq. 2 (``morphological_complexity(formula=...)``)."""
+
+
+def morphological_complexity(morphology: Morphology | Iterable[SensorSpec | Mapping[str, Any]],
+                             formula: str = "paper") -> float:
     """Paper eq. 2: ``C = 100 - 5 * sum_i [(f_i - minF)/(maxF - minF) + (r_i - minR)/(maxR - minR)]``.
 
     Bounds per type come from ``SENSOR_TYPES`` (minR = 0). A bottom sensor costs a flat 10.
     Higher C = simpler: 100 for no sensors, 0 for ten sensors at maximum range and FOV.
+
+    ``formula = "original"``: eq. 2 as the original code computed it: the range term counted
+    twice (``10 * (r_i - minR)/(maxR - minR)``), no FOV term, and an infrared sensor a flat 10
+    like the bottom sensor (its class name fell through the type mapping).
     """
+    if formula not in COMPLEXITY_FORMULAS:
+        raise ValueError(f"formula={formula!r}; allowed: {', '.join(map(repr, COMPLEXITY_FORMULAS))}")
     morph = Morphology.coerce(morphology if isinstance(morphology, Morphology) else list(morphology))
+    original = formula == "original"
     penalty = 0.0
     for s in morph:
         spec = SENSOR_TYPES[s.type]
-        if not spec.configurable:
+        if not spec.configurable or (original and s.type == "infrared"):
             penalty += BOTTOM_SENSOR_COST
             continue
-        fov_term = (s.fov - spec.fov_min) / (spec.fov_max - spec.fov_min)
         range_term = (s.range - spec.range_min) / (spec.range_max - spec.range_min)
+        if original:
+            penalty += 5.0 * range_term + 5.0 * range_term
+            continue
+        fov_term = (s.fov - spec.fov_min) / (spec.fov_max - spec.fov_min)
         penalty += 5.0 * (fov_term + range_term)
     return 100.0 - penalty

@@ -63,7 +63,9 @@ def test_shipped_cppn_outputs_signed_and_bottom_on_node0():
 def test_shipped_neat_m_sensor_defaults():
     gc = load(NEATMGenome).genome_config
     assert gc.sensor_remove_prob == 0.0                        # not in the original
-    assert NEATMGenome.parse_config  # noqa: B018 - the class parses its own section
+    # the original's sensor operators, read from the shipped section (not class defaults)
+    assert (gc.sensor_add_prob, gc.sensor_angle_mutate_prob, gc.sensor_reach_mutate_prob) == (0.07, 0.1, 0.07)
+    assert gc.sensor_types == ["infrared", "ultrasonic", "colour", "camera", "bottom"]
 
 
 # ---------------------------------------------------------------- shared breeding

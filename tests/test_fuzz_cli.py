@@ -30,7 +30,7 @@ import tomllib
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, settings
+from hypothesis import HealthCheck, seed, settings
 from hypothesis import strategies as st
 
 from evolution.analysis.reevaluate import CACHE_FILE as REEVALUATION_CACHE
@@ -340,6 +340,9 @@ def _make(prop, examples: int, slow: bool):
     @given(data=st.data())
     def test(base, data):
         prop(base, data)
+
+    if slow:  # other examples than the fast run's, from a fixed seed (reproducible)
+        test = seed(20261201)(test)
 
     test.__doc__ = prop.__name__
     return pytest.mark.slow(test) if slow else test

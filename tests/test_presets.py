@@ -38,8 +38,12 @@ def test_presets_are_the_repository_configs_folder():
 def test_list_prints_every_preset_with_its_first_comment_sentence(capsys):
     assert evolve_main(["--list"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    listed = {line.split()[0]: line.split(None, 1)[1] for line in lines}
-    assert set(listed) == PAPER_PRESETS | {"hyperneat_m.neat.cfg", "neat_m.neat.cfg"}
+    listed = {line.split()[0]: line.split(None, 1)[1] for line in lines if not line.startswith("#")}
+    original = {f"{name}-original" for name in ("S1", "S2", "S3", "M1", "M2", "M3")}
+    assert set(listed) == PAPER_PRESETS | original | {"hyperneat_m.neat.cfg", "neat_m.neat.cfg"}
+    # one header line per set: the paper's presets, the original protocol's, the neat configs
+    assert [line.split(":")[0] for line in lines if line.startswith("#")] == [
+        '# protocol "paper"', '# protocol "original"', "# neat-python configs"]
     # hand-read from the files' opening comments
     assert listed["S1"] == "Experiment S1 of the paper: single objective (task performance), environment 1."
     assert listed["M3"].startswith("Experiment M3 of the paper: multi-objective")

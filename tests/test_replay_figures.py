@@ -66,7 +66,8 @@ def test_film_strip_panels_full_view(champion, tmp_path):
     (["--cones", "9"], "error: --cones: robot index 9 does not exist (8 robots); allowed:"),
     (["--view", "top"], "error: --view: 'top' is not a view; allowed: 'full', 'zone' or 'follow:K' with K in 0..7"),
     (["--view", "follow:8"], "error: --view: robot 8 does not exist"),
-    (["--size", "20"], "error: --size: 20 is not an integer >= 64; allowed: an integer >= 64"),
+    (["--size", "20"], "error: --size: 20 is not an integer in 64..4096; allowed: an integer in 64..4096 (pixels)"),
+    (["--size", "100000"], "error: --size: 100000 is not an integer in 64..4096"),
     (["--trail", "-2"], "error: --trail: -2 is not an integer >= 0; allowed:"),
     (["--min-robot-px", "0"], "error: --min-robot-px: 0 is not an integer >= 1; allowed:"),
     (["--strip", "0,50", "--png", "s.png"], "error: --strip: step 50 is outside the episode; allowed: "

@@ -35,7 +35,7 @@ from scipy import stats as sps
 
 from evolution.reproduction.pareto import non_dominated_fronts
 from evolution.run.champion import ChampionError, champion_objectives, read_json
-from evolution.run.stats import read_stats
+from evolution.run.stats import check_generations, read_stats
 
 SELECTION_POINTS = ("max", "mean", "knee", "epsilon")
 EPSILON = 0.10
@@ -87,6 +87,7 @@ def load_run(path: Path) -> Run:
             value = record.get(key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise ValueError(f"{path / 'stats.jsonl'}: record {i} has {key} = {value!r}; allowed: a finite number")
+    check_generations(path / "stats.jsonl", records)
     champion = None
     champ_file = path / "champion.json"
     if champ_file.exists():

@@ -15,7 +15,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from evolution.analysis.fronts import SELECTION_POINTS, Analysis, Comparison, nothing_to_compare  # noqa: E402
-from evolution.guard import check_output_dir  # noqa: E402
+from evolution.guard import check_output_dir, writing  # noqa: E402
 
 ENV_COLOURS = {1: "tab:blue", 2: "tab:orange", 3: "tab:red"}
 POINT_MARKERS = {"max": "^", "mean": "s", "knee": "D", "epsilon": "P"}
@@ -40,14 +40,15 @@ def write_table4(analysis: Analysis, out: Path) -> tuple[Path, Path]:
     test in ``note``) and table4.md; with nothing to compare, the markdown is that one line."""
     fields = [f.name for f in dataclasses.fields(Comparison)] + ["note"]
     csv_path = out / "table4.csv"
-    with open(csv_path, "w", newline="") as f:
+    with writing(csv_path), open(csv_path, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=fields)
         writer.writeheader()
         writer.writerows({**c.__dict__, "note": c.untested or ""} for c in analysis.comparisons)
     md_path = out / "table4.md"
     empty = nothing_to_compare(analysis)
     if empty:
-        md_path.write_text(empty + "\n")
+        with writing(md_path):
+            md_path.write_text(empty + "\n")
         return md_path, csv_path
     envs = sorted({c.environment for c in analysis.comparisons})
     lines = ["| SO vs | " + " | ".join(f"env {e} ft | env {e} C" for e in envs) + " |",
@@ -57,7 +58,8 @@ def write_table4(analysis: Analysis, out: Path) -> tuple[Path, Path]:
         parts = [table4_cell(cell[(e, point, obj)]) if (e, point, obj) in cell else ""
                  for e in envs for obj in ("task", "morphology")]
         lines.append(f"| {point} | " + " | ".join(parts) + " |")
-    md_path.write_text("\n".join(lines) + "\n")
+    with writing(md_path):
+        md_path.write_text("\n".join(lines) + "\n")
     return md_path, csv_path
 
 
@@ -97,7 +99,8 @@ def figure4(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="best")
     path = out / "figure4_fronts.png"
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
@@ -119,7 +122,8 @@ def figure5(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7)
     path = out / "figure5_simplicity.png"
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
@@ -141,7 +145,8 @@ def figure6(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7)
     path = out / "figure6_points.png"
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
@@ -197,5 +202,6 @@ def write_report(analysis: Analysis, out: Path) -> Path:
               f"are in `{table_csv.name}`.", "", table_md.read_text(), "## Figures", ""]
     lines += [f"![{f.stem}]({f.name})" for f in figs]
     path = out / "report.md"
-    path.write_text("\n".join(lines) + "\n")
+    with writing(path):
+        path.write_text("\n".join(lines) + "\n")
     return path

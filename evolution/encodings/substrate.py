@@ -21,6 +21,9 @@ target); every output is clipped to [-1, 1]. Decoding:
   [-1, 1] (infrared, ultrasonic, camera, colour: the original's order); fov and range mapped linearly from
   [-1, 1] onto the type's bounds (range onto [``range_floor`` * max, max] since 0 is
   excluded), orientation onto [-pi/2, pi/2]; bearing = atan2(y, x) of the input node;
+* ``decode_window`` (default 1): the share of each interval (range, FOV, orientation) the
+  outputs reach, centred on its middle; the original code reached only the middle 0.2 (its
+  Encog ``NormalizedField`` mapped [-1, 1] as if from [-5, 5]);
 * an input node with no outgoing link has **no sensor** and no controller input;
 * ``bottom_on_node0`` (default on, as in the original): input node 0 (the front of the
   robot) always carries a bottom sensor instead of a configurable one, whatever its links.
@@ -64,6 +67,7 @@ class Substrate:
     output_activation: str = "steep_sigmoid"
     hidden_activation: str = "tanh"
     bias_threshold: bool = False
+    decode_window: float = 1.0
 
     def __post_init__(self) -> None:
         if not 1 <= self.num_inputs <= 10:
@@ -80,6 +84,8 @@ class Substrate:
             raise ValueError(f"substrate sensor_types={list(self.sensor_types)}; allowed: a non-empty list of {allowed}")
         if self.hidden_nodes < 0:
             raise ValueError(f"substrate hidden_nodes={self.hidden_nodes}; allowed: >= 0")
+        if not 0.0 < self.decode_window <= 1.0:
+            raise ValueError(f"substrate decode_window={self.decode_window}; allowed: (0, 1]")
         if not 0.0 < self.range_floor < 1.0:
             raise ValueError(f"substrate range_floor={self.range_floor}; allowed: (0, 1)")
 
@@ -108,12 +114,13 @@ class Substrate:
         bands = len(self.sensor_types)
         kind = self.sensor_types[min(int((o[TYPE] + 1.0) / 2.0 * bands), bands - 1)]
         spec = SENSOR_TYPES[kind]
-        unit = lambda v: (v + 1.0) / 2.0  # noqa: E731 - [-1, 1] -> [0, 1]
+        window = self.decode_window
+        unit = lambda v: (window * v + 1.0) / 2.0  # noqa: E731 - [-1, 1] -> the window of [0, 1]
         low = self.range_floor * spec.range_max
         return SensorSpec(
             kind,
             bearing=bearing,
-            orientation=float(o[ORIENT] * math.pi / 2),
+            orientation=float(window * o[ORIENT] * math.pi / 2),
             range=float(low + unit(o[RANGE]) * (spec.range_max - low)),
             fov=float(spec.fov_min + unit(o[FOV]) * (spec.fov_max - spec.fov_min)),
         )

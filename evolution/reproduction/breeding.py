@@ -214,7 +214,19 @@ class NEATReproduction(neat.DefaultReproduction):
     Config section ``[NEATReproduction]``: ``elitism`` and ``min_species_size`` as in
     neat-python's ``DefaultReproduction``; the truncation fraction is the genome section's
     ``parent_fraction`` (one value shared with the MO arm).
+
+    **Ratchet** (``config.reproduction_config.ratchet = True``, set from the experiment's
+    ``elitism = "ratchet"``; the original code's SO elitism): the best genome ever seen (by
+    fitness; a later genome replaces it only by beating it) is carried into every new
+    population as it is, with its fitness, and ``carried`` names it so that the trainer does
+    not evaluate it again; no other genome survives (the per-species ``elitism`` is not used)
+    and the other ``pop_size - 1`` genomes are offspring.
     """
+
+    def __init__(self, config: Any, reporters: Any, stagnation: Any) -> None:
+        super().__init__(config, reporters, stagnation)
+        self.best: Any = None
+        self.carried: set[int] = set()
 
     @classmethod
     def parse_config(cls, param_dict: dict[str, str]) -> DefaultClassConfig:
@@ -224,9 +236,29 @@ class NEATReproduction(neat.DefaultReproduction):
         return DefaultClassConfig(param_dict, [ConfigParameter("elitism", int, 0),
                                                ConfigParameter("min_species_size", int, 1)], cls.__name__)
 
+    def _exact_spawn(self, spawn: list[int], total: int, min_size: int) -> list[int]:
+        """neat-python's ``_adjust_spawn_exact``, repeated: it gives up after one pass over the
+        species even when a further pass could still take genomes from species above the minimum
+        (and raises), but it changes ``spawn`` in place, so each call gets closer."""
+        for _ in range(total + len(spawn)):
+            try:
+                return self._adjust_spawn_exact(spawn, total, min_size)
+            except RuntimeError as err:
+                if "Internal error" not in str(err):
+                    raise
+        return self._adjust_spawn_exact(spawn, total, min_size)
+
     def reproduce(self, config: Any, species: Any, pop_size: int, generation: int) -> dict[int, Any]:
         config.genome_config.innovation_tracker = self.innovation_tracker
         self.innovation_tracker.reset_generation()
+        ratchet = getattr(self.reproduction_config, "ratchet", False)
+        if ratchet:
+            for s in species.species.values():
+                for k in sorted(s.members):
+                    g = s.members[k]
+                    if self.best is None or g.fitness > self.best.fitness:
+                        self.best = g
+        self.carried = set()
         remaining, fitnesses = [], []
         for sid, s, stagnant in self.stagnation.update(species, generation):
             if stagnant:
@@ -241,20 +273,31 @@ class NEATReproduction(neat.DefaultReproduction):
         for s in remaining:  # neat-python's adjusted fitness
             s.adjusted_fitness = (mean([m.fitness for m in s.members.values()]) - low) / span
         cfg = self.reproduction_config
-        min_size = max(cfg.min_species_size, cfg.elitism)
+        elitism = 0 if ratchet else cfg.elitism
+        offspring = pop_size - 1 if ratchet else pop_size
+        min_size = max(cfg.min_species_size, elitism)
+        if len(remaining) * min_size > offspring:
+            # more species than offspring places (the original's speciation can form many): the
+            # species with the lowest adjusted fitness get none and die out (Encog's levelOff)
+            ranked_species = sorted(remaining, key=lambda s: (s.adjusted_fitness, -s.key), reverse=True)
+            kept = {s.key for s in ranked_species[:max(offspring // min_size, 1)]}
+            remaining = [s for s in remaining if s.key in kept]
         spawn = self.compute_spawn([s.adjusted_fitness for s in remaining], [len(s.members) for s in remaining],
-                                   pop_size, min_size)
-        spawn = self._adjust_spawn_exact(spawn, pop_size, min_size)
+                                   offspring, min_size)
+        spawn = self._exact_spawn(spawn, offspring, min_size)
 
         new_population: dict[int, Any] = {}
+        if ratchet:
+            new_population[self.best.key] = self.best  # as it is: not evaluated again
+            self.carried = {self.best.key}
         species.species = {}
         for n, s in zip(spawn, remaining):
-            n = max(n, cfg.elitism)
+            n = max(n, elitism)
             members = dict(s.members)
             s.members = {}
             species.species[s.key] = s
             ranked = sorted(members, key=lambda k: (members[k].fitness, k), reverse=True)
-            elites = ranked[:cfg.elitism]
+            elites = ranked[:elitism]
             for k in elites:
                 new_population[k] = members[k]
             n -= len(elites)

@@ -7,6 +7,9 @@ episode is exactly the one ``parallel_env(**env_config)`` gives for its seed.
 
 Trial seeds are derived from (run seed, generation, trial index) only, so every genome of
 a generation meets the same worlds and a result does not depend on which process ran it.
+With ``layout = "per_run"`` (the original code) every trial of every generation has the
+seed of (run seed, 0, 0): the simulation is deterministic, so the trials would be the same
+episode, and it is run once (``episode_seeds``).
 """
 
 from __future__ import annotations
@@ -26,6 +29,16 @@ _SIM_CACHE: dict[str, VectorSimulation] = {}
 def trial_seed(run_seed: int, generation: int, trial: int) -> int:
     """The episode seed of ``trial`` in ``generation`` of a run (a 32-bit integer)."""
     return int(np.random.SeedSequence([int(run_seed), int(generation), int(trial)]).generate_state(1)[0])
+
+
+def episode_seeds(run_seed: int, generation: int, trials: int, layout: str = "per_trial") -> list[int]:
+    """The seeds of the episodes a genome of ``generation`` runs: one per trial, or with
+    ``layout = "per_run"`` the run's single layout, once (its trials would be identical)."""
+    if layout == "per_run":
+        return [trial_seed(run_seed, 0, 0)]
+    if layout != "per_trial":
+        raise ValueError(f"layout={layout!r}; allowed: 'per_trial', 'per_run'")
+    return [trial_seed(run_seed, generation, trial) for trial in range(trials)]
 
 
 def decode_genome(method: str, genome: Any, config: Any, substrate: Any = None):
@@ -121,14 +134,16 @@ def run_trials(sims: VectorSimulation, controller, morphology: Morphology,
 
 
 def evaluate(genome: Any, config: Any, env_config: dict[str, Any], trials: int = 5, seed: int = 0,
-             generation: int = 0, method: str = "hyperneat-m", substrate: Any = None) -> Evaluation:
+             generation: int = 0, method: str = "hyperneat-m", substrate: Any = None,
+             layout: str = "per_trial", complexity: str = "paper") -> Evaluation:
     """Decode ``genome`` and run its team for ``trials`` episodes.
 
     Args:
         genome: a neat-python genome of the method's genome class. config: its ``neat.Config``.
         env_config: keyword arguments of ``gathering_env.parallel_env``.
         trials: episodes; the task objective is the mean ft. seed: the run seed.
-        generation: used with ``seed`` to derive the trial seeds.
+        generation: used with ``seed`` to derive the trial seeds. layout: ``episode_seeds``.
+        complexity: the formula of eq. 2 (``gathering_env.morphological_complexity``).
 
     Returns:
         An ``Evaluation`` with the three objectives, per-trial ft and sensor statistics.
@@ -136,12 +151,12 @@ def evaluate(genome: Any, config: Any, env_config: dict[str, Any], trials: int =
     t0 = time.perf_counter()
     controller, morphology = decode_genome(method, genome, config, substrate)
     t_decode = time.perf_counter() - t0
-    sims = _worlds_for(env_config, trials)
-    seeds = [trial_seed(seed, generation, trial) for trial in range(trials)]
+    seeds = episode_seeds(seed, generation, trials, layout)
+    sims = _worlds_for(env_config, len(seeds))
     fts, total_steps, t_env, t_ctrl = run_trials(sims, controller, morphology, seeds)
     return Evaluation(
         task=float(np.mean(fts)),
-        morphology=morphological_complexity(morphology),
+        morphology=morphological_complexity(morphology, complexity),
         controller=100.0 - float(controller.num_links),
         trial_ft=[float(f) for f in fts],
         sensors=sensor_statistics(morphology),

@@ -15,6 +15,13 @@ Layout (every key optional except where noted; defaults are the paper's, docs/mo
     speciation = "adaptive"      # optional: overrides the neat config's species_mode
                                  # ("adaptive" | "original" | "fixed", evolution.reproduction.species)
     neat_config = "hyperneat_m.neat.cfg"   # neat-python config (see "neat_config" below)
+    protocol = "original"        # a named bundle of the options below (evolution.run.protocol)
+    layout = "per_trial"         # "per_trial": fresh layouts from (seed, generation, trial);
+                                 # "per_run": one layout for the whole run (the original code)
+    elitism = "species"          # "species": the [NEATReproduction] elites, re-evaluated;
+                                 # "ratchet" (SO): only the best-ever genome is carried over,
+                                 # with its stored score, never re-evaluated (the original code)
+    complexity = "paper"         # eq. 2: "paper" or "original" (gathering_env.morphological_complexity)
 
     [environment]                # any gathering_env keyword: environment, max_cycles, ...
     environment = 2
@@ -48,10 +55,14 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from evolution.run.protocol import PROTOCOLS, apply_protocol
 from gathering_env.config import WorldConfig
+from gathering_env.sensors import COMPLEXITY_FORMULAS
 from gathering_env.world import GatheringWorld
 
 METHODS = ("hyperneat-m", "neat-m")
+LAYOUTS = ("per_trial", "per_run")
+ELITISM = ("species", "ratchet")
 OBJECTIVES = ("task", "morphology", "controller")
 DEFAULT_NEAT_CONFIGS = {"hyperneat-m": "hyperneat_m.neat.cfg", "neat-m": "neat_m.neat.cfg"}
 PRESET_PACKAGE = "evolution.presets"
@@ -72,7 +83,8 @@ def _species_modes() -> tuple[str, ...]:
 
 
 #: Keys whose value is one of a few names.
-CHOICES = {"method": lambda: METHODS, "speciation": _species_modes}
+CHOICES = {"method": lambda: METHODS, "speciation": _species_modes, "protocol": lambda: PROTOCOLS,
+           "layout": lambda: LAYOUTS, "elitism": lambda: ELITISM, "complexity": lambda: COMPLEXITY_FORMULAS}
 
 
 class ExperimentError(ValueError):
@@ -86,7 +98,7 @@ def presets_dir() -> Path:
     folder; in an installed wheel, the package ``evolution.presets`` that setuptools
     built from that folder.
     """
-    checkout = Path(__file__).resolve().parents[2]
+    checkout = Path(__file__).resolve().parents[2]  # evolution/run/experiment.py -> the checkout
     if (checkout / "pyproject.toml").is_file() and (checkout / "configs" / "__init__.py").is_file():
         return checkout / "configs"
     return Path(str(resources.files(PRESET_PACKAGE)))
@@ -98,6 +110,53 @@ CONFIG_DIR = presets_dir()
 def preset_names() -> list[str]:
     """Names of the shipped experiment presets (the ``*.toml`` files, without suffix)."""
     return sorted(p.stem for p in CONFIG_DIR.glob("*.toml"))
+
+
+PROTOCOL_EXPERIMENTS = ("S1", "S2", "S3", "M1", "M2", "M3")
+"""The paper's experiments, also shipped under every other protocol as ``<name>-<protocol>``."""
+
+
+def protocol_preset_names() -> list[str]:
+    """The paper's experiments under the other protocols: ``S1-original`` ... ``M3-original``."""
+    return [f"{name}-{protocol}" for protocol in PROTOCOLS if protocol != "paper" for name in PROTOCOL_EXPERIMENTS]
+
+
+def resolve_preset(name: str) -> tuple[Path, dict[str, Any]]:
+    """(file, overrides) of an experiment preset: ``S1`` is ``configs/S1.toml``; ``S1-original``
+    is the same file with ``protocol = "original"`` and ``name = "S1-original"``.
+
+    Raises:
+        ExperimentError: no such preset; the one-line message lists the known ones.
+    """
+    if name in protocol_preset_names():
+        base, protocol = name.split("-", 1)
+        return CONFIG_DIR / f"{base}.toml", {"protocol": protocol, "name": name}
+    known = preset_names() + protocol_preset_names()
+    if name not in known:
+        raise ExperimentError(f"{name}: unknown preset; known: {', '.join(known)} (or the path of an experiment file)")
+    return CONFIG_DIR / f"{name}.toml", {}
+
+
+def preset_text(name: str) -> str:
+    """The TOML text of a preset (what ``--dump`` prints); a protocol preset is its base file
+    with the ``protocol`` key added and its name changed, so that the text loads to the preset."""
+    if name not in protocol_preset_names():
+        return preset_path(name, neat_configs=True).read_text(encoding="utf-8")
+    path, overrides = resolve_preset(name)
+    lines = []
+    for line in path.read_text(encoding="utf-8").splitlines():
+        if line.startswith("name ="):
+            line = f'name = "{overrides["name"]}"'
+        lines.append(line)
+        if line.strip() == "[experiment]":
+            lines.append(f'protocol = "{overrides["protocol"]}"   # evolution.run.protocol')
+    return f"# {name}: {protocol_preset_description(name)}\n" + "\n".join(lines) + "\n"
+
+
+def protocol_preset_description(name: str) -> str:
+    """One line: which paper experiment under which protocol."""
+    base, protocol = name.split("-", 1)
+    return f"experiment {base} of the paper under protocol = \"{protocol}\" (as the published runs were made)."
 
 
 def neat_config_names() -> list[str]:
@@ -135,10 +194,13 @@ def preset_description(name: str) -> str:
 def is_preset_name(arg: str) -> bool:
     """Whether a command-line EXPERIMENT argument means a preset rather than a file.
 
-    A preset name has no path separator and no ``.toml`` suffix and is not an existing file;
-    anything else is a path, as before presets existed.
+    A preset name has no path separator and no ``.toml`` suffix and is not an existing file,
+    nor an existing folder unless it is a shipped preset's name; anything else is a path (so a
+    folder is reported as a folder, not as an unknown preset).
     """
-    return not (any(sep in arg for sep in "/\\") or arg.endswith(".toml") or Path(arg).is_file())
+    if any(sep in arg for sep in "/\\") or arg.endswith(".toml") or Path(arg).is_file():
+        return False
+    return arg in preset_names() or not Path(arg).exists()
 
 
 @dataclass(frozen=True)
@@ -154,6 +216,10 @@ class Experiment:
     trials: int = 5
     convergence_stop: bool = True
     speciation: str | None = None  # None: the neat config's [GatheringSpeciesSet] species_mode
+    protocol: str | None = None
+    layout: str = "per_trial"
+    elitism: str = "species"
+    complexity: str = "paper"
     neat_config: Path = field(default_factory=lambda: CONFIG_DIR / DEFAULT_NEAT_CONFIGS["hyperneat-m"])
     environment: dict[str, Any] = field(default_factory=lambda: {"environment": 2, "max_cycles": 10_000})
     substrate: dict[str, Any] = field(default_factory=dict)
@@ -276,6 +342,16 @@ def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str,
     unknown = sorted(set(exp_section) - _EXPERIMENT_KEYS)
     if unknown:
         raise ExperimentError(f"{source}: unknown key(s) {unknown} in [experiment]; allowed: {sorted(_EXPERIMENT_KEYS)}")
+    if exp_section.get("protocol", "") is None:
+        del exp_section["protocol"]  # a saved experiment without a protocol
+    if "protocol" in exp_section:
+        _check_key(source, "protocol", exp_section["protocol"])  # before its bundle is applied
+        try:
+            apply_protocol(exp_section["protocol"], {"experiment": exp_section, "environment": env_section,
+                                                     "substrate": sub_section},
+                           source, exp_section.get("method", "hyperneat-m"))
+        except ValueError as err:
+            raise ExperimentError(str(err)) from None
     values: dict[str, Any] = {"source": source}
     for key, value in exp_section.items():
         values[key] = _check_key(source, key, value)

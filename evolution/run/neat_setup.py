@@ -53,6 +53,9 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
             hint = " (rename the section [DefaultSpeciesSet] to [GatheringSpeciesSet]: evolution.reproduction.species)"
         raise ExperimentError(f"{path}: invalid neat-python config: {err}{hint}") from None
     check_neat_config(config, path)
+    if not experiment.multi_objective:
+        # the experiment's elitism: "ratchet" carries the best-ever genome, unscored (NEATReproduction)
+        config.reproduction_config.ratchet = experiment.elitism == "ratchet"
     config.pop_size = experiment.population
     species = config.species_set_config
     if experiment.speciation is not None:

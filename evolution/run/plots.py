@@ -8,6 +8,8 @@ from typing import Any
 
 import matplotlib
 
+from evolution.guard import writing
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
@@ -23,7 +25,8 @@ def plot_run(records: Sequence[dict[str, Any]], path: Path, title: str = "") -> 
     fig = run_figure(records, title)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 

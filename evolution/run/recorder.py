@@ -18,7 +18,7 @@ from typing import Any
 import neat
 
 from evolution.run.champion import save_champion
-from evolution.run.checkpoint import save_checkpoint
+from evolution.run.checkpoint import atomic_write_bytes, save_checkpoint
 from evolution.run.evaluate import Evaluation, decode_genome
 from evolution.run.experiment import Experiment
 from evolution.run.stats import append_stats, generation_record, write_stats
@@ -61,8 +61,9 @@ class RunRecorder:
     def write_new_run(self, population: neat.Population) -> None:
         """The files of a new run: experiment.json, neat.cfg and the first checkpoint."""
         self.run_dir.mkdir(parents=True, exist_ok=True)
-        (self.run_dir / "experiment.json").write_text(json.dumps(self.experiment.to_dict(), indent=1) + "\n")
-        (self.run_dir / "neat.cfg").write_text(self.neat_cfg_text, encoding="utf-8")
+        atomic_write_bytes(self.run_dir / "experiment.json",
+                           (json.dumps(self.experiment.to_dict(), indent=1) + "\n").encode())
+        atomic_write_bytes(self.run_dir / "neat.cfg", self.neat_cfg_text.encode())
         self.save_checkpoint(population)
 
     def rewrite_stats(self) -> None:
@@ -145,7 +146,7 @@ class RunRecorder:
             genome = reproduction.parents.get(key) or reproduction.front_genomes[key]
             controller, morphology = decode_genome(exp.method, genome, self.config, self.substrate)
             values = dict(zip(exp.objectives, objectives))
-            values.setdefault("morphology", morphology_simplicity(morphology))
+            values.setdefault("morphology", morphology_simplicity(morphology, exp.complexity))
             values.setdefault("controller", 100.0 - float(controller.num_links))
             save_champion(front_dir / f"genome-{key}.json", method=exp.method, experiment=exp.name,
                           generation=generation, genome=genome, morphology=morphology,

@@ -36,7 +36,7 @@ T_TYPE, T_BEARING, T_OFFSET, T_RANGE, T_COS_HALF, T_SIN_HALF, T_INV_RANGE = rang
 # Entries of the float parameter vector (see ``world_params``).
 (P_RADIUS, P_ARENA_W, P_ARENA_H, P_ZX0, P_ZY0, P_ZX1, P_ZY1, P_FALLOFF, P_IR_GAMMA, P_DT,
  P_MAX_SPEED, P_ZONE_CX, P_ZONE_CY, P_AVOID_DIST, P_BOX_W, P_BOX_D, P_REACH, P_TOTAL_VALUE,
- P_MAX_CYCLES) = range(19)
+ P_MAX_CYCLES, P_BOX_OFFSET) = range(20)
 # Entries of the integer flag vector.
 F_IR_GAMMA, F_AVOIDANCE, F_PICKUP = range(3)
 # Event kinds reported by ``settle`` (rows of the int event table: kind, world, robot, block, slot).
@@ -67,7 +67,7 @@ def world_params(config) -> tuple[np.ndarray, np.ndarray]:
         config.robot_radius, config.arena_width, config.arena_height, x0, y0, x1, y1,
         config.bottom_falloff, config.ir_gamma, config.dt, config.robot_max_speed, cx, cy,
         config.collision_avoidance_distance, config.pickup_box_width, config.pickup_box_depth,
-        config.pickup_reach, config.total_value, config.max_cycles,
+        config.pickup_reach, config.total_value, config.max_cycles, config.pickup_box_offset,
     ], dtype=np.float64)
     flags = np.array([config.ir_response == "gamma", config.collision_avoidance, config.pickup_heuristic],
                      dtype=np.int64)
@@ -374,11 +374,10 @@ def gathered_blocks(block_pos, block_angle, block_half, params, active, gathered
 @njit(cache=True)
 def _in_pickup_box(px, py, a, bx, by, ba, half, params):
     """Does the block's nearest point to the robot's pickup-box centre lie in the box?"""
-    r = params[P_RADIUS]
     box_w, box_d = params[P_BOX_W], params[P_BOX_D]
     hx = math.cos(a)
     hy = math.sin(a)
-    centre_offset = r + 0.5 * box_d
+    centre_offset = params[P_BOX_OFFSET]
     box_x = px + centre_offset * hx
     box_y = py + centre_offset * hy
     cb = math.cos(ba)
@@ -417,7 +416,7 @@ def settle(raw, robot_rows, block_rows, active, block_half, block_need, block_va
     n_blocks = block_angle.shape[1]
     r = params[P_RADIUS]
     pickup = flags[F_PICKUP] != 0
-    prefilter = r + params[P_BOX_D] + 0.5 * params[P_BOX_W]
+    prefilter = params[P_BOX_OFFSET] + 0.5 * (params[P_BOX_D] + params[P_BOX_W])
     reach_limit = params[P_REACH] * r
     count = 0
     now = np.empty(n_blocks, dtype=np.bool_)

@@ -1,7 +1,8 @@
 """Team heuristics as array operations: pickup detection, attached-robot drive, avoidance.
 
 * **Pickup** (docs/model.md §2, on by default): a robot whose pickup box (``pickup_box_width``
-  wide, ``pickup_box_depth`` deep, in front of its rim) holds an ungathered block with a
+  wide, ``pickup_box_depth`` deep, in front of its rim, or with ``pickup_box = "centre"``
+  centred on the robot's centre as in the original code) holds an ungathered block with a
   free anchor attaches to it (``GatheringWorld.try_attach``).
 * **Attached drive**: an attached robot ignores its controller and drives at full power
   towards the gathering zone's centre, forwards when the centre lies ahead of it and
@@ -38,7 +39,7 @@ def pickup_candidates(world: GatheringWorld, gathered: np.ndarray) -> list[tuple
     if blocks.size == 0:
         return []
     # Cheap prefilter on centre distances; the exact box test runs on the few survivors.
-    reach = cfg.robot_radius + cfg.pickup_box_depth + 0.5 * cfg.pickup_box_width
+    reach = cfg.pickup_box_offset + 0.5 * (cfg.pickup_box_depth + cfg.pickup_box_width)
     reach = reach + world.block_half[blocks] * math.sqrt(2.0)
     dx = world.block_pos[blocks, 0] - world.robot_pos[free_robots, 0:1]
     dy = world.block_pos[blocks, 1] - world.robot_pos[free_robots, 1:2]
@@ -49,7 +50,7 @@ def pickup_candidates(world: GatheringWorld, gathered: np.ndarray) -> list[tuple
     pos = world.robot_pos[free_robots]
     ang = world.robot_angle[free_robots]
     hx, hy = np.cos(ang), np.sin(ang)
-    centre_offset = cfg.robot_radius + 0.5 * cfg.pickup_box_depth
+    centre_offset = cfg.pickup_box_offset
     box_x = pos[:, 0] + centre_offset * hx                         # (P,)
     box_y = pos[:, 1] + centre_offset * hy
     # Nearest block point to the box centre, per (robot, block).

@@ -1,0 +1,390 @@
+"""The original protocol (``protocol = "original"``): each option against the original code's
+behaviour or a hand value, the bundle's rules, its presets, and resuming a run under it."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+
+import numpy as np
+import pytest
+
+from evolution.cli import evolve_main
+from evolution.encodings.substrate import Substrate
+from evolution.run import backends
+from evolution.run.evaluate import Evaluation, episode_seeds, trial_seed
+from evolution.run.experiment import ExperimentError, load_experiment, preset_text, resolve_preset
+from evolution.run.protocol import ORIGINAL, protocol_values
+from evolution.run.recorder import convergence_target
+from evolution.run.stats import read_stats, without_timing
+from gathering_env import Morphology, SensorSpec, morphological_complexity
+from gathering_env.compiled import kernels
+from gathering_env.config import WorldConfig
+from gathering_env.reference.heuristics import pickup_candidates
+from gathering_env.simulation import GatheringSimulation
+
+# A small world where blocks get gathered; its zone depth is left to the protocol (4).
+WORLD = """
+[environment]
+environment = 1
+arena_width = 10.0
+arena_height = 10.0
+zone_width = 10.0
+block_counts = [8, 0, 0]
+max_cycles = 80
+num_robots = 10
+"""
+
+
+def experiment(tmp_path, name="orig", generations=3, population=8, body="protocol = \"original\""):
+    path = tmp_path / f"{name}.toml"
+    path.write_text(f"[experiment]\nname = \"{name}\"\ngenerations = {generations}\npopulation = {population}\n"
+                    f"trials = 3\nseed = 5\n{body}\n" + WORLD)
+    return path
+
+
+def evolve(exp, out, *more):
+    assert evolve_main([str(exp), "--out", str(out), "--workers", "1", "--no-progress", *more]) == 0
+
+
+# ---------------------------------------------------------------------------- the bundle
+def test_the_protocol_sets_every_original_option(tmp_path):
+    exp = load_experiment(experiment(tmp_path))
+    assert (exp.layout, exp.elitism, exp.complexity) == ("per_run", "ratchet", "original")
+    world = exp.world_config()
+    assert (world.zone_depth, world.pickup_box, world.pickup_box_width, world.pickup_box_depth) == (4.0, "centre",
+                                                                                                    0.2, 0.1)
+    assert exp.substrate["decode_window"] == 0.2
+    assert exp.substrate["bias_threshold"] is True and exp.speciation == "original"
+    # without the key every option keeps the paper's default ...
+    plain = load_experiment(experiment(tmp_path, "plain", body=""))
+    assert (plain.layout, plain.elitism, plain.complexity, plain.protocol, plain.speciation) == (
+        "per_trial", "species", "paper", None, None)
+    assert (plain.world_config().zone_depth, plain.world_config().pickup_box) == (8.0, "front")
+    # ... "paper" names those defaults, and each option can be set on its own
+    assert protocol_values("paper")["environment"]["zone_depth"] == 8.0
+    alone = load_experiment(experiment(tmp_path, "alone", body='layout = "per_run"'))
+    assert (alone.layout, alone.elitism) == ("per_run", "species")
+
+
+@pytest.mark.parametrize("body,needle", [
+    ('protocol = "orig"', "[experiment] protocol='orig'; allowed: ['paper', 'original']"),
+    ('protocol = "original"\nlayout = "per_trial"',
+     "[experiment] layout = 'per_trial' contradicts protocol = 'original'; allowed: 'per_run'"),
+    ('protocol = "paper"\nelitism = "ratchet"',
+     "[experiment] elitism = 'ratchet' contradicts protocol = 'paper'; allowed: 'species'"),
+    ('layout = "everywhere"', "[experiment] layout='everywhere'; allowed: ['per_trial', 'per_run']"),
+])
+def test_unknown_or_contradicting_options_name_the_file_and_key(tmp_path, capsys, body, needle):
+    path = experiment(tmp_path, body=body)
+    with pytest.raises(ExperimentError, match=None) as err:
+        load_experiment(path)
+    assert str(err.value).startswith(str(path)) and needle in str(err.value)
+    assert evolve_main([str(path), "--out", str(tmp_path / "run")]) == 2
+    out = capsys.readouterr().err.strip()
+    assert len(out.splitlines()) == 1 and needle in out
+    assert not (tmp_path / "run").exists()
+
+
+def test_a_world_key_contradicting_the_protocol_is_refused(tmp_path, capsys):
+    path = experiment(tmp_path)
+    path.write_text(path.read_text() + "zone_depth = 8\n")
+    assert evolve_main([str(path), "--out", str(tmp_path / "run")]) == 2
+    assert f"{path}: [environment] zone_depth = 8 contradicts protocol = 'original'; allowed: 4.0" in \
+        capsys.readouterr().err
+    # the command-line flag contradicts a file's own key in the same way
+    plain = experiment(tmp_path, "plain", body='elitism = "species"')
+    assert evolve_main([str(plain), "--protocol", "original", "--out", str(tmp_path / "run")]) == 2
+    assert "[experiment] elitism = 'species' contradicts protocol = 'original'" in capsys.readouterr().err
+
+
+def test_presets_under_the_original_protocol(capsys):
+    path, overrides = resolve_preset("S1-original")
+    assert path.name == "S1.toml" and overrides == {"protocol": "original", "name": "S1-original"}
+    s1 = load_experiment(path)
+    s1o = load_experiment(path, overrides)
+    assert (s1o.name, s1o.protocol, s1o.population, s1o.generations, s1o.trials) == ("S1-original", "original",
+                                                                                    150, 250, 5)
+    assert s1o.world_config().max_cycles == s1.world_config().max_cycles == 10_000
+    assert s1o.environment == s1.environment | ORIGINAL["environment"]
+    # --dump prints a file that loads to the same experiment
+    assert evolve_main(["--dump", "M2-original"]) == 0
+    text = capsys.readouterr().out
+    assert text == preset_text("M2-original") and 'protocol = "original"' in text
+    assert evolve_main(["--list"]) == 0
+    listed = capsys.readouterr().out.splitlines()
+    names = [line.split()[0] for line in listed if not line.startswith("#")]
+    assert {f"{e}-original" for e in ("S1", "S2", "S3", "M1", "M2", "M3")} <= set(names) and "S1" in names
+    headers = [line for line in listed if line.startswith("# protocol")]
+    assert len(headers) == 2 and "original" in headers[1]
+
+
+def test_dumped_protocol_preset_loads_like_the_preset(tmp_path, capsys):
+    assert evolve_main(["--dump", "S2-original"]) == 0
+    mine = tmp_path / "mine.toml"
+    mine.write_text(capsys.readouterr().out)
+    dumped = load_experiment(mine)
+    path, overrides = resolve_preset("S2-original")
+    preset = load_experiment(path, overrides)
+    assert {k: v for k, v in dumped.to_dict().items() if k != "source"} == \
+        {k: v for k, v in preset.to_dict().items() if k != "source"}
+
+
+# ---------------------------------------------------------------------------- one layout per run
+def test_one_layout_for_every_trial_and_generation():
+    once = [trial_seed(7, 0, 0)]
+    for generation in (0, 1, 9, 200):
+        assert episode_seeds(7, generation, 5, "per_run") == once   # run once: the trials would be equal
+    per_trial = {s for g in range(3) for s in episode_seeds(7, g, 5)}
+    assert len(per_trial) == 15
+    # the same seed gives the same layout (every robot and block pose)
+    layouts = []
+    for _ in range(2):
+        sim = GatheringSimulation(WorldConfig.from_kwargs(environment=1))
+        sim.reset(seed=once[0])
+        layouts.append(np.concatenate([sim.world.robot_pos.ravel(), sim.world.robot_angle,
+                                       sim.world.block_pos.ravel(), sim.world.block_angle]))
+    np.testing.assert_array_equal(*layouts)
+
+
+def test_a_genome_meets_the_same_episode_in_every_generation(tmp_path, monkeypatch):
+    """Every evaluation of a per_run experiment runs one episode, on the run's one seed."""
+    seen = []
+    real = backends.evaluate
+
+    def spy(*args, **kwargs):
+        ev = real(*args, **kwargs)
+        seen.append((kwargs["generation"], episode_seeds(kwargs["seed"], kwargs["generation"], kwargs["trials"],
+                                                         kwargs["layout"]), len(ev.trial_ft), ev.steps))
+        return ev
+
+    monkeypatch.setattr(backends, "evaluate", spy)
+    evolve(experiment(tmp_path, generations=2, population=6), tmp_path / "run")
+    assert {g for g, *_ in seen} == {0, 1}
+    assert all(seeds == [trial_seed(5, 0, 0)] and n == 1 and 0 < steps <= 80 for _, seeds, n, steps in seen)
+
+
+# ---------------------------------------------------------------------------- the ratchet
+def _fake_scores(monkeypatch, calls):
+    """Evaluations that depend on the genome only: ft from its key (no simulation)."""
+
+    def fake(genome, config, env_config, trials=5, seed=0, generation=0, method="hyperneat-m", substrate=None,
+             layout="per_trial", complexity="paper"):
+        calls.append((generation, genome.key))
+        task = float((genome.key * 37) % 101)
+        return Evaluation(task=task, morphology=50.0, controller=90.0, trial_ft=[task],
+                          sensors={"num_sensors": 0.0, **{f"count_{t}": 0.0 for t in
+                                                          ("infrared", "ultrasonic", "colour", "camera", "bottom")},
+                                   **{f"{p}_{t}": float("nan") for p in ("range", "fov")
+                                      for t in ("infrared", "ultrasonic", "colour", "camera")}},
+                          steps=1)
+
+    monkeypatch.setattr(backends, "evaluate", fake)
+
+
+def test_the_best_genome_is_carried_over_without_being_scored_again(tmp_path, monkeypatch):
+    calls: list[tuple[int, int]] = []
+    _fake_scores(monkeypatch, calls)
+    exp = experiment(tmp_path, generations=5, population=10, body='elitism = "ratchet"\nconvergence_stop = false')
+    evolve(exp, tmp_path / "run")
+    records = read_stats(tmp_path / "run" / "stats.jsonl")
+    by_gen: dict[int, list[int]] = {}
+    for g, key in calls:
+        by_gen.setdefault(g, []).append(key)
+    scored = set()
+    best_ever = (-1.0, None)
+    for g in range(5):
+        keys = by_gen[g]
+        assert not scored & set(keys)                        # nothing is ever scored twice
+        scored |= set(keys)
+        if g > 0:
+            assert len(keys) == 9                            # 10 genomes: the carried best + 9 offspring
+            assert records[g]["genomes"] == 10
+        for key in keys:
+            task = float((key * 37) % 101)
+            if task > best_ever[0]:
+                best_ever = (task, key)
+        # the record's best is the best-ever score (the carried genome's stored one)
+        assert records[g]["task_best"] == best_ever[0]
+        assert records[g]["best_genome"] == best_ever[1]
+    assert records[-1]["steps"] == 9                          # the carried genome adds no steps
+
+
+def test_without_the_ratchet_the_elites_are_scored_again(tmp_path, monkeypatch):
+    calls: list[tuple[int, int]] = []
+    _fake_scores(monkeypatch, calls)
+    evolve(experiment(tmp_path, generations=3, population=10, body="convergence_stop = false"), tmp_path / "run")
+    keys = [k for _, k in calls]
+    assert len(keys) > len(set(keys))                         # species elites meet a new evaluation
+
+
+def test_the_stop_compares_the_best_ever_score_with_110(tmp_path, monkeypatch):
+    calls: list[tuple[int, int]] = []
+    _fake_scores(monkeypatch, calls)
+    exp = load_experiment(experiment(tmp_path))
+    assert convergence_target(exp) == 110.0 == 100 + exp.world_config().time_bonus / 2
+
+    def scores(genome, config, env_config, **kwargs):  # genome 13 is the first to reach 110
+        calls.append((kwargs["generation"], genome.key))
+        task = 110.0 if genome.key == 13 else 50.0 + genome.key / 100
+        return Evaluation(task=task, morphology=50.0, controller=90.0, trial_ft=[task],
+                          sensors=Evaluation.failure("").sensors, steps=1)
+
+    monkeypatch.setattr(backends, "evaluate", scores)
+    evolve(experiment(tmp_path, generations=20), tmp_path / "run")
+    records = read_stats(tmp_path / "run" / "stats.jsonl")
+    stop = next(g for g, key in calls if key == 13)
+    assert len(records) == stop + 1 and records[-1]["task_best"] == 110.0
+    assert all(r["task_best"] < 110 for r in records[:-1])
+
+
+def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_path):
+    exp = experiment(tmp_path, generations=4, population=8, body='protocol = "original"\nconvergence_stop = false')
+    evolve(exp, tmp_path / "whole")
+    evolve(exp, tmp_path / "part", "--generations", "2")
+    evolve(exp, tmp_path / "part", "--resume")
+    whole = without_timing(read_stats(tmp_path / "whole" / "stats.jsonl"))
+    part = without_timing(read_stats(tmp_path / "part" / "stats.jsonl"))
+    assert len(whole) == 4 and part == whole
+    saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
+    assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0
+    shutil.rmtree(tmp_path / "part")
+
+
+# ---------------------------------------------------------------------------- zone 20 x 4
+def test_zone_of_the_original_is_20_by_4():
+    exp = load_experiment(*resolve_preset("S1-original"))
+    cfg = exp.world_config()
+    assert cfg.zone_rect == (10.0, 0.0, 30.0, 4.0)            # x in [10, 30], y in [0, 4] (hand value)
+    gathered = {}
+    for depth, y in ((4.0, 3.7), (4.0, 3.85), (8.0, 3.85)):   # a small block: half side 0.2
+        world = WorldConfig.from_kwargs(environment=None, block_counts=(1, 0, 0), num_robots=1, zone_depth=depth)
+        sim = GatheringSimulation(world)
+        sim.reset(seed=0)
+        sim.world.place_block(0, 20.0, y, 0.0)
+        sim.world.place_robot(0, 5.0, 30.0, 0.0)
+        sim.step(np.zeros((1, 2)))
+        gathered[(depth, y)] = bool(sim.gathered[0])
+    assert gathered == {(4.0, 3.7): True, (4.0, 3.85): False, (8.0, 3.85): True}
+
+
+# ---------------------------------------------------------------------------- the pickup box
+BLOCK = (20.0, 20.0)
+ORIGINAL_BOX = dict(pickup_box="centre", pickup_box_width=0.2, pickup_box_depth=0.1)
+
+
+def _scene(gap, **box):
+    """One small block; one robot north of it facing it, ``gap`` from its rim to the block's face
+    (negative: the block overlaps the robot's body)."""
+    cfg = WorldConfig.from_kwargs(environment=None, block_counts=(1, 0, 0), num_robots=1, **box)
+    sim = GatheringSimulation(cfg)
+    sim.reset(seed=0)
+    sim.world.place_block(0, *BLOCK, 0.0)
+    half, r = sim.world.block_half[0], cfg.robot_radius
+    sim.world.place_robot(0, BLOCK[0], BLOCK[1] + half + r + gap, -math.pi / 2)
+    return sim
+
+
+def _compiled_box(sim):
+    params, _ = kernels.world_params(sim.config)
+    w = sim.world
+    return kernels._in_pickup_box(w.robot_pos[0, 0], w.robot_pos[0, 1], w.robot_angle[0], w.block_pos[0, 0],
+                                  w.block_pos[0, 1], w.block_angle[0], w.block_half[0], params)
+
+
+@pytest.mark.parametrize("gap,front,centre", [
+    (0.01, True, False),     # touching the front rim, not the body: grips only with the paper's box
+    (0.15, True, False),     # inside the paper's 0.2-deep box ahead of the rim
+    (-0.08, True, False),    # overlapping the body by 0.08: the face 0.07 ahead of the centre, box reaches 0.05
+    (-0.11, True, True),     # overlapping by 0.11: the face 0.04 ahead of the centre, inside the centre box
+])
+def test_centre_pickup_box_needs_the_block_on_the_body(gap, front, centre):
+    for box, want in ((dict(), front), (ORIGINAL_BOX, centre)):
+        sim = _scene(gap, **box)
+        assert (pickup_candidates(sim.world, np.zeros(1, bool)) == [(0, 0)]) is want, (gap, box)
+        assert bool(_compiled_box(sim)) is want, (gap, box)
+
+
+def test_a_block_at_the_rim_is_not_gripped_with_the_centre_box():
+    for kernel in ("numpy", "compiled"):
+        paper, original = _scene(0.01, kernel=kernel), _scene(0.01, kernel=kernel, **ORIGINAL_BOX)
+        for sim in (paper, original):
+            sim.step(np.zeros((1, 2)))
+        assert paper.world.robot_attached[0] == 0 and original.world.robot_attached[0] == -1
+    assert WorldConfig(**ORIGINAL_BOX).pickup_box_offset == 0.0
+    assert WorldConfig().pickup_box_offset == pytest.approx(0.15 + 0.1)
+    with pytest.raises(ValueError, match="pickup_box='middle'; allowed: 'front', 'centre'"):
+        WorldConfig(pickup_box="middle")
+
+
+# ---------------------------------------------------------------------------- decoding window, eq. 2
+def test_decoded_range_fov_and_orientation_reach_the_middle_20_percent():
+    """Hand values of the original (NormalizedField over [-5, 5] fed with [-1, 1])."""
+    sub = Substrate(decode_window=0.2, sensor_types=("infrared", "ultrasonic", "camera", "colour"))
+    out = np.zeros(6)
+    reach = {}
+    for v in (-1.0, 1.0):
+        out[1] = out[2] = out[3] = v                           # fov, orientation, range
+        for kind, t in (("infrared", -0.9), ("ultrasonic", -0.2), ("camera", 0.2), ("colour", 0.9)):
+            out[4] = t
+            s = sub.sensor_from_outputs(out, 0.0)
+            assert s.type == kind                               # the original's type order
+            reach.setdefault(kind, []).append((s.range, s.fov, s.orientation))
+    (r0, f0, o0), (r1, f1, o1) = reach["infrared"]
+    assert (r0, r1) == pytest.approx((4.006, 6.004)) and (f0, f1) == pytest.approx((1.3614, 1.7802), abs=1e-4)
+    assert (o0, o1) == pytest.approx((-math.pi / 10, math.pi / 10))
+    (r0, f0, _), (r1, f1, _) = reach["camera"]
+    assert (r0, r1) == pytest.approx((8.012, 12.008), abs=1e-3) and (f0, f1) == pytest.approx((1.3265, 1.8151),
+                                                                                              abs=1e-4)
+    (r0, f0, _), (r1, f1, _) = reach["ultrasonic"]
+    assert (r0, r1) == pytest.approx((10.015, 15.01), abs=1e-3) and (f0, f1) == pytest.approx((1.3166, 1.9250),
+                                                                                              abs=1e-4)
+    # the default reaches the whole interval, as before
+    full = Substrate().sensor_from_outputs(np.array([0, 1.0, 1.0, 1.0, -0.9, 0]), 0.0)
+    assert (full.range, full.fov, full.orientation) == (10.0, 5 * math.pi / 6, math.pi / 2)
+    with pytest.raises(ValueError, match=r"decode_window=0; allowed: \(0, 1\]"):
+        Substrate(decode_window=0)
+
+
+def test_original_eq_2_counts_range_twice_no_fov_and_infrared_flat():
+    morph = Morphology([
+        SensorSpec("bottom"),
+        SensorSpec("infrared", 0.5, 0.0, 5.0, 2.0),             # original: flat 10
+        SensorSpec("ultrasonic", 1.0, 0.0, 12.5, 3.0),          # range 0.5 of 25 -> 10 * 0.5 = 5
+        SensorSpec("camera", -1.0, 0.0, 4.0, 1.0),              # 4/20 = 0.2 -> 2
+        SensorSpec("colour", 2.0, 0.0, 10.0, math.pi / 6),      # 1.0 -> 10, whatever the FOV
+    ])
+    assert morphological_complexity(morph, "original") == pytest.approx(100 - 10 - 10 - 5 - 2 - 10)
+    # the paper's: bottom 10, then 5 * (FOV fraction + range fraction) for every configurable sensor
+    fov = lambda f, lo, hi: (f - lo) / (hi - lo)  # noqa: E731
+    paper = 100 - 10 - 5 * (fov(2.0, math.pi / 6, 5 * math.pi / 6) + 0.5) - 5 * (fov(3.0, 0.1, math.pi) + 0.5) \
+        - 5 * (fov(1.0, math.pi / 9, 8 * math.pi / 9) + 0.2) - 5 * (0.0 + 1.0)
+    assert morphological_complexity(morph) == pytest.approx(paper)
+    # its C falls only by dropping or retyping sensors: FOV changes nothing
+    wider = Morphology([SensorSpec("ultrasonic", 1.0, 0.0, 12.5, 0.2)])
+    assert morphological_complexity(wider, "original") == morphological_complexity(
+        Morphology([SensorSpec("ultrasonic", 1.0, 0.0, 12.5, 3.0)]), "original") == 95.0
+    with pytest.raises(ValueError, match="formula='2018'; allowed: 'paper', 'original'"):
+        morphological_complexity(morph, "2018")
+
+
+def test_a_run_records_the_original_complexity(tmp_path):
+    evolve(experiment(tmp_path, generations=1, population=6), tmp_path / "run")
+    champion = json.loads((tmp_path / "run" / "champion.json").read_text())
+    morph = Morphology.from_dict({"sensors": champion["morphology"]} if isinstance(champion["morphology"], list)
+                                 else champion["morphology"])
+    assert champion["objectives"]["morphology"] == pytest.approx(morphological_complexity(morph, "original"))
+
+
+def test_spawn_counts_reach_the_offspring_places_exactly():
+    """With the ratchet N - 1 places are left; neat-python's adjustment alone gives up on this one."""
+    import neat
+
+    from evolution.reproduction.breeding import NEATReproduction
+
+    with pytest.raises(RuntimeError, match="could not match"):
+        neat.DefaultReproduction._adjust_spawn_exact(None, [3, 2, 1, 1, 1, 1, 1], 7, 1)
+    repro = NEATReproduction.__new__(NEATReproduction)
+    assert repro._exact_spawn([3, 2, 1, 1, 1, 1, 1], 7, 1) == [1] * 7
+    assert repro._exact_spawn([1, 1, 1], 6, 1) == [2, 2, 2]
