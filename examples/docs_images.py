@@ -16,6 +16,9 @@ checks that the list and the pictures in docs/ are the same). The steps:
   docs/evidence/README.md);
 * ``evidence`` (docs/evidence/figure*.png, with the report they belong to): ``gathering-analyze``
   of those runs; needs ``--evidence DIR``;
+* ``learning`` (docs/evidence/learning/*.png): ``benchmarks/bench_learning.py --resume`` on its
+  runs (``make bench-learning``'s ``runs/bench-learning``), then its figure and the two runs'
+  ``stats.png``; needs ``--learning DIR``;
 * ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
   docs/rl/README.md; needs ``--rl DIR`` (the runs) and the demo champion.
 
@@ -48,6 +51,7 @@ RL_CURVES = {
     "curve-oldbonus-shaped-local-env1.png": "ppo-oldbonus-shaped-local-env1",
     "curve-ent0-oldbonus-shaped-team-env1.png": "ppo-ent0-oldbonus-shaped-team-env1",
 }
+LEARNING = ("learning.png", "S1/stats.png", "M1/stats.png")
 RL_FIGURES = tuple(f"compare-env{e}-{s}.png" for e in (1, 2) for s in (2000, 10000)) + \
     ("curves-env1.png", "curves-env2.png")
 
@@ -55,7 +59,7 @@ RL_FIGURES = tuple(f"compare-env{e}-{s}.png" for e in (1, 2) for s in (2000, 100
 @dataclass(frozen=True)
 class Step:
     outputs: tuple[str, ...]        # pictures, relative to docs/
-    needs: str | None               # None, "evidence" or "rl"
+    needs: str | None               # None, "evidence", "learning" or "rl"
     make: Callable[[argparse.Namespace], None]
 
 
@@ -108,6 +112,13 @@ def make_evidence(args: argparse.Namespace) -> None:
             shutil.copy2(produced, DOCS / "evidence" / produced.name)
 
 
+def make_learning(args: argparse.Namespace) -> None:
+    run(sys.executable, "benchmarks/bench_learning.py", "--out", args.learning, "--resume")
+    target = DOCS / "evidence" / "learning"
+    for picture in LEARNING:
+        shutil.copy2(args.learning / picture, target / picture)
+
+
 def make_rl(args: argparse.Namespace) -> None:
     champion = demo_champion(args)
     run(sys.executable, "examples/rl_figures.py", "--runs", args.rl, "--champion", champion.parent,
@@ -121,6 +132,7 @@ STEPS: dict[str, Step] = {
     "random-episode": Step(("random_episode.png",), None, make_random_episode),
     "evolved-team": Step(("evolved_team.png",), "evidence", make_evolved_team),
     "evidence": Step(tuple(f"evidence/{f}" for f in EVIDENCE_FIGURES), "evidence", make_evidence),
+    "learning": Step(tuple(f"evidence/learning/{f}" for f in LEARNING), "learning", make_learning),
     "rl": Step(tuple(f"rl/{f}" for f in (*RL_FIGURES, *RL_CURVES)), "rl", make_rl),
 }
 
@@ -143,6 +155,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="champion.json for the gallery (default: make demo's, out/quick/champion.json)")
     parser.add_argument("--evidence", type=Path, default=None,
                         help="folder of the evidence runs (S2-seed1 ... M2-seed2; docs/evidence/README.md)")
+    parser.add_argument("--learning", type=Path, default=None,
+                        help="folder of the learning benchmark's runs (make bench-learning: runs/bench-learning)")
     parser.add_argument("--rl", type=Path, default=None, help="folder of the PPO runs of docs/rl/README.md")
     args = parser.parse_args(argv)
     chosen = list(STEPS) if args.only is None else [s.strip() for s in args.only.split(",") if s.strip()]
