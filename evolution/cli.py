@@ -83,17 +83,20 @@ def evolve_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--max-retries", type=int_arg(0, 100), default=2,
                         help="retries of a failing evaluation (default 2)")
     group = parser.add_argument_group("overrides of the experiment file")
-    group.add_argument("--name")
+    group.add_argument("--name", help="the run's name ([experiment] name; default run folder runs/<name>-seed<seed>)")
     group.add_argument("--protocol", choices=PROTOCOLS,
                        help="a named bundle of world and method options (docs/fidelity.md); "
                             "'original' = the 2018 code behind the published figures")
-    group.add_argument("--method", choices=METHODS)
-    group.add_argument("--objectives", help="comma-separated: task,morphology,controller")
-    group.add_argument("--seed", type=int_arg(*LIMITS["seed"]))
-    group.add_argument("--generations", type=int_arg(*LIMITS["generations"]))
-    group.add_argument("--population", type=int_arg(*LIMITS["population"]))
-    group.add_argument("--trials", type=int_arg(*LIMITS["trials"]))
-    group.add_argument("--environment", type=int, help="environment preset 1, 2 or 3")
+    group.add_argument("--method", choices=METHODS, help="hyperneat-m (CPPN) or neat-m (direct encoding)")
+    group.add_argument("--objectives", help="comma-separated, all maximised: task (ft), morphology (simplicity C), "
+                                             "controller (100 - links); more than one = NEAT-MODS")
+    group.add_argument("--seed", type=int_arg(*LIMITS["seed"]),
+                       help="run seed: every random choice of the run flows from it")
+    group.add_argument("--generations", type=int_arg(*LIMITS["generations"]), help="generations to evolve")
+    group.add_argument("--population", type=int_arg(*LIMITS["population"]), help="genomes per generation")
+    group.add_argument("--trials", type=int_arg(*LIMITS["trials"]),
+                       help="episodes per genome; its fitness is their mean ft")
+    group.add_argument("--environment", type=int, help="environment preset 1, 2 or 3 (paper Table 2)")
     group.add_argument("--steps", type=int, help="steps per trial (max_cycles)")
     group.add_argument("--robots", type=int, help="team size (num_robots)")
     args = parser.parse_args(argv)
@@ -189,10 +192,11 @@ def replay_main(argv: list[str] | None = None) -> int:
     parser.add_argument("champion", type=Path, help="champion JSON written by gathering-evolve")
     parser.add_argument("--environment", type=int, choices=(1, 2, 3), help="preset (default: the one it evolved in)")
     parser.add_argument("--steps", type=int_arg(1, 10**9), help="episode length (default: the evolved max_cycles)")
-    parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0)
+    parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0,
+                        help="the episode's seed (default 0): an episode the champion was not trained on")
     parser.add_argument("--out", type=Path, default=Path("team.gif"), help=".gif or .mp4")
     parser.add_argument("--frame-every", type=int_arg(1, 10**9), default=10, help="record every k-th step")
-    parser.add_argument("--fps", type=int_arg(1, 1000), default=15)
+    parser.add_argument("--fps", type=int_arg(1, 1000), default=15, help="frames per second of the video (default 15)")
     parser.add_argument("--png", type=Path, help="also save the last frame (or with --strip a film strip) as PNG")
     look = parser.add_argument_group("what the frames show (docs/rendering.md)")
     look.add_argument("--cones", help="whose sensor cones: auto (default), all, none or robot indices like 0,3")
@@ -205,7 +209,7 @@ def replay_main(argv: list[str] | None = None) -> int:
     look.add_argument("--sensors-png", type=Path, help="also save the team's sensor layout (like the paper's Figure 3)")
     args = parser.parse_args(argv)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    from evolution.replay import replay
+    from evolution.replay import replay, unseen_note
     from evolution.run.champion import load_champion
     from gathering_env.render import RenderOptionError
 
@@ -236,6 +240,7 @@ def replay_main(argv: list[str] | None = None) -> int:
     print(f"{champion.experiment or 'champion'} ({champion.method}, {len(champion.morphology)} sensors) in "
           f"environment {env_config.get('environment')}: ft = {info['task_performance']:.2f}, gathered "
           f"{info['gathered_value']:.0f}/{info['total_value']:.0f} in {info['steps']} steps")
+    print(unseen_note(champion, env_config, args.seed))
     print(f"wrote {path} ({frames} frames)")
     for picture in (args.png, args.sensors_png):
         if picture is not None:
@@ -265,7 +270,7 @@ def analyze_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--backend", choices=BACKENDS, default="process",
                         help="where --reevaluate runs (default: process pool)")
     args = parser.parse_args(argv)
-    from evolution.analysis.fronts import analyse
+    from evolution.analysis.fronts import analyse, nothing_to_compare
     from evolution.analysis.report import REPORT_FILES, write_report
     from evolution.guard import check_output_dir
 
@@ -273,6 +278,9 @@ def analyze_main(argv: list[str] | None = None) -> int:
     analysis = analyse(args.runs, reevaluate=args.reevaluate, workers=args.workers, backend=args.backend)
     path = write_report(analysis, args.out)
     print(f"{len(analysis.runs)} runs, {len(analysis.comparisons)} comparisons -> {path}")
+    untested = sorted({c.untested for c in analysis.comparisons if c.untested})
+    for line in filter(None, [nothing_to_compare(analysis), *untested]):
+        print(line)
     print(f"ft used: {analysis.scores}")
     return 0
 

@@ -99,3 +99,19 @@ def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
         else:
             save_png(last, png)
     return info, Path(out), video.frames
+
+
+def unseen_note(champion: Champion, env_config: dict[str, Any], seed: int) -> str:
+    """One line saying how the replayed episode relates to the champion's training score.
+
+    A champion's ``task`` objective is its mean ft over the trial episodes of training, drawn
+    from the run's seed; a replay runs the episode of ``seed``, which is none of them, so its ft
+    is a single unseen episode and may be far from the training score."""
+    trained = champion.objectives.get("task")
+    if trained is None:
+        return f"an unseen episode (seed {seed}): the champion file holds no training ft to compare with"
+    changed = [key for key in ("environment", "max_cycles", "num_robots")
+               if key in env_config and env_config[key] != champion.environment.get(key, env_config[key])]
+    world = f" in a changed world ({', '.join(changed)})" if changed else ""
+    return (f"an unseen episode (seed {seed}){world}: the training ft {trained:.2f} is the mean over the "
+            f"run's own trial episodes; one new episode can score far from it")

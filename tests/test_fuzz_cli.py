@@ -305,7 +305,7 @@ def prop_analysis_input(base, data) -> None:
                                   min_size=1, max_size=3), label="runs")
         out = data.draw(st.sampled_from(["rep", "empty", "run", "afile", "partial"]), label="out")
         code, err = run_cli(analyze_main, [*runs, "--out", out])
-        # the one file analysis adds to a run directory: its re-evaluation cache (issue 10)
+        # the one file analysis adds to a run directory: its re-evaluation cache
         check(work, before, code, err, new_outputs(work) + [f"run/{REEVALUATION_CACHE}"])
 
 

@@ -285,7 +285,7 @@ def test_save_video_mp4(tmp_path):
     assert len(back) == 4 and back[0].shape[:2] == (162, 162)
 
 
-# ---------------------------------------------------------------------- legible replays (issue 13)
+# ---------------------------------------------------------------------- legible replays
 def empty_arena_colour(renderer: Renderer, sim: GatheringSimulation, frame: np.ndarray) -> np.ndarray:
     """(H, W, 3) colour every arena pixel would have with nothing on it (FLOOR or ZONE), by hand."""
     h, w = frame.shape[:2]

@@ -47,7 +47,7 @@ def test_compare_two_policies_writes_table_and_figure(tmp_path, capsys):
     assert compare_main(["--policy", "random", "--policy", "heuristic", "--environment", "1", "--steps", "60",
                          "--robots", "5", "--episodes", "2", "--out", str(tmp_path)]) == 0
     header = (tmp_path / "compare.csv").read_text().splitlines()[0].split(",")
-    assert header == ["policy", "sensors", "episodes", "ft_mean", "ft_std", "small", "medium", "large",
+    assert header == ["policy", "sensors", "episodes", "ft_mean", "ft_std", "ft_se", "small", "medium", "large",
                       "finished", "steps_to_finish"]
     assert (tmp_path / "compare.png").read_bytes()[:4] == b"\x89PNG"
     table = (tmp_path / "compare.md").read_text()

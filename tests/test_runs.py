@@ -92,6 +92,25 @@ def test_neat_m_mo_run_resumes_to_the_uninterrupted_result(mo_run, tmp_path):
     assert json.loads((copy / "champion.json").read_text()) == json.loads((run / "champion.json").read_text())
 
 
+def test_a_run_directory_moves_between_machines(mo_run, tmp_path):
+    from evolution.cli import evolve_main
+
+    exp, run = mo_run
+    recorded = json.loads((run / "experiment.json").read_text())
+    assert recorded["neat_config"] == "neat_m.neat.cfg"          # a preset's name, no folder
+    assert len(recorded["neat_config_sha256"]) == 64
+    for path in run.rglob("*"):                                   # no text file names a folder of this machine
+        if path.suffix in {".json", ".jsonl", ".csv", ".cfg"}:
+            assert str(run.parent) not in path.read_text(), path
+    here, moved = tmp_path / "here", tmp_path / "elsewhere" / "deeper" / "run"
+    shutil.copytree(run, here)
+    shutil.copytree(run, moved)
+    for target in (here, moved):  # the run's own experiment, one generation more
+        assert evolve_main(["--resume", str(target), "--generations", "3", "--workers", "1", "--no-progress"]) == 0
+    assert without_timing(read_stats(moved / "stats.jsonl")) == without_timing(read_stats(here / "stats.jsonl"))
+    assert len(read_stats(moved / "stats.jsonl")) == 3
+
+
 class ScriptedEvaluator:
     """Gives genome 0 of generation g the task score ``scores[g]`` and every other genome 0."""
 

@@ -1,4 +1,4 @@
-"""Hand-placed sensor scenes: readings computed by hand from SPEC section 3."""
+"""Hand-placed sensor scenes: readings computed by hand from docs/model.md §3."""
 
 from __future__ import annotations
 

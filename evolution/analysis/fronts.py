@@ -180,6 +180,30 @@ class Comparison:
     n_mo: int
 
 
+    @property
+    def untested(self) -> str | None:
+        """Why there is no t-test (None when there is one): too few runs, or no variation."""
+        if self.n_so < 2 or self.n_mo < 2:
+            return f"too few runs for a test (SO {self.n_so}, MO {self.n_mo}; a t-test needs 2 of each)"
+        if math.isnan(self.p_value):
+            return (f"no variation (every SO run {self.so_mean:.2f}, every MO run {self.mo_mean:.2f}): "
+                    "no test")
+        return None
+
+
+def nothing_to_compare(analysis: Analysis) -> str | None:
+    """One line when Table 4 has no cell (no environment with both SO and MO runs), else None."""
+    if analysis.comparisons:
+        return None
+
+    def envs(multi: bool) -> str:
+        found = sorted({r.environment for r in analysis.runs if r.multi_objective == multi})
+        return "environment " + ", ".join(map(str, found)) if found else "none"
+
+    return (f"nothing to compare: Table 4 needs SO and MO runs of the same environment "
+            f"(SO runs: {envs(False)}; MO runs: {envs(True)})")
+
+
 def _shapiro(sample: np.ndarray) -> float:
     if len(sample) < 3 or np.ptp(sample) == 0:
         return float("nan")

@@ -37,6 +37,7 @@ from evolution.run.experiment import Experiment
 from evolution.run.lock import RunLock
 from evolution.run.recorder import RunRecorder, convergence_target
 from evolution.run.rundir import check_new_run_dir, new_run, restore_run
+from gathering_env.compiled.engine import announce_compile
 
 
 @dataclass
@@ -165,6 +166,8 @@ class Trainer:
         # Starting a backend (Ray in particular) may draw from Python's global random generator,
         # which is neat-python's: keep the lineage independent of the backend.
         random_state = random.getstate()
+        if dict(exp.environment).get("kernel", "compiled") == "compiled":
+            announce_compile()  # here, once: not from every worker, nor across the progress bar
         evaluator = self._evaluator = make_evaluator(context, self.workers, self.backend, self.ray_address,
                                                      self.max_retries)
         random.setstate(random_state)
