@@ -55,7 +55,7 @@ RL_FIGURES = tuple(f"compare-env{e}-{s}.png" for e in (1, 2) for s in (2000, 100
 @dataclass(frozen=True)
 class Step:
     outputs: tuple[str, ...]        # pictures, relative to docs/
-    needs: str | None               # None, "evidence" or "rl"
+    needs: str | None               # None, "evidence", "rl" or "learning"
     make: Callable[[argparse.Namespace], None]
 
 
@@ -108,6 +108,21 @@ def make_evidence(args: argparse.Namespace) -> None:
             shutil.copy2(produced, DOCS / "evidence" / produced.name)
 
 
+LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
+LEARNING_RUN_FILES = ("stats.png", "stats.jsonl", "stats.csv", "experiment.json", "champion.json")
+
+
+def make_learning(args: argparse.Namespace) -> None:
+    """The learning benchmark's figure and small files, from ``make bench-learning``'s folder
+    (``--learning DIR``; the benchmark itself takes about an hour)."""
+    target = DOCS / "evidence" / "learning"
+    for name in LEARNING_FILES:
+        shutil.copy2(args.learning / name, target / name)
+    for run_name in ("S1", "M1"):
+        for name in LEARNING_RUN_FILES:
+            shutil.copy2(args.learning / run_name / name, target / run_name / name)
+
+
 def make_rl(args: argparse.Namespace) -> None:
     champion = demo_champion(args)
     run(sys.executable, "examples/rl_figures.py", "--runs", args.rl, "--champion", champion.parent,
@@ -122,6 +137,8 @@ STEPS: dict[str, Step] = {
     "evolved-team": Step(("evolved_team.png",), "evidence", make_evolved_team),
     "evidence": Step(tuple(f"evidence/{f}" for f in EVIDENCE_FIGURES), "evidence", make_evidence),
     "rl": Step(tuple(f"rl/{f}" for f in (*RL_FIGURES, *RL_CURVES)), "rl", make_rl),
+    "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
+                      "evidence/learning/M1/stats.png"), "learning", make_learning),
 }
 
 
@@ -141,6 +158,8 @@ def main(argv: list[str] | None = None) -> int:
                         help=f"comma-separated steps to run (default: all whose inputs are given): {', '.join(STEPS)}")
     parser.add_argument("--champion", type=Path, default=None,
                         help="champion.json for the gallery (default: make demo's, out/quick/champion.json)")
+    parser.add_argument("--learning", type=Path, default=None,
+                        help="folder of make bench-learning (runs/bench-learning): the learning benchmark's figures")
     parser.add_argument("--evidence", type=Path, default=None,
                         help="folder of the evidence runs (S2-seed1 ... M2-seed2; docs/evidence/README.md)")
     parser.add_argument("--rl", type=Path, default=None, help="folder of the PPO runs of docs/rl/README.md")
