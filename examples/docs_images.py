@@ -125,8 +125,10 @@ def make_learning(args: argparse.Namespace) -> None:
 
 def make_rl(args: argparse.Namespace) -> None:
     champion = demo_champion(args)
-    run(sys.executable, "examples/rl_figures.py", "--runs", args.rl, "--champion", champion.parent,
-        "--out", DOCS / "rl")
+    made = ROOT / "out" / "rl-figures"  # rl_figures.py writes only into its own folder, never docs/rl
+    run(sys.executable, "examples/rl_figures.py", "--runs", args.rl, "--champion", champion.parent, "--out", made)
+    for picture in RL_FIGURES:
+        shutil.copy2(made / picture, DOCS / "rl" / picture)
     for picture, run_dir in RL_CURVES.items():
         shutil.copy2(args.rl / run_dir / "curve.png", DOCS / "rl" / picture)
 
