@@ -16,9 +16,6 @@ checks that the list and the pictures in docs/ are the same). The steps:
   docs/evidence/README.md);
 * ``evidence`` (docs/evidence/figure*.png, with the report they belong to): ``gathering-analyze``
   of those runs; needs ``--evidence DIR``;
-* ``learning`` (docs/evidence/learning/*.png): ``benchmarks/bench_learning.py --resume`` on its
-  runs (``make bench-learning``'s ``runs/bench-learning``), then its figure and the two runs'
-  ``stats.png``; needs ``--learning DIR``;
 * ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
   docs/rl/README.md; needs ``--rl DIR`` (the runs) and the demo champion.
 
@@ -51,7 +48,6 @@ RL_CURVES = {
     "curve-oldbonus-shaped-local-env1.png": "ppo-oldbonus-shaped-local-env1",
     "curve-ent0-oldbonus-shaped-team-env1.png": "ppo-ent0-oldbonus-shaped-team-env1",
 }
-LEARNING = ("learning.png", "S1/stats.png", "M1/stats.png")
 RL_FIGURES = tuple(f"compare-env{e}-{s}.png" for e in (1, 2) for s in (2000, 10000)) + \
     ("curves-env1.png", "curves-env2.png")
 
@@ -59,7 +55,7 @@ RL_FIGURES = tuple(f"compare-env{e}-{s}.png" for e in (1, 2) for s in (2000, 100
 @dataclass(frozen=True)
 class Step:
     outputs: tuple[str, ...]        # pictures, relative to docs/
-    needs: str | None               # None, "evidence", "learning" or "rl"
+    needs: str | None               # None, "evidence", "rl" or "learning"
     make: Callable[[argparse.Namespace], None]
 
 
@@ -112,17 +108,27 @@ def make_evidence(args: argparse.Namespace) -> None:
             shutil.copy2(produced, DOCS / "evidence" / produced.name)
 
 
+LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
+LEARNING_RUN_FILES = ("stats.png", "stats.jsonl", "stats.csv", "experiment.json", "champion.json")
+
+
 def make_learning(args: argparse.Namespace) -> None:
-    run(sys.executable, "benchmarks/bench_learning.py", "--out", args.learning, "--resume")
+    """The learning benchmark's figure and small files, from ``make bench-learning``'s folder
+    (``--learning DIR``; the benchmark itself takes about an hour)."""
     target = DOCS / "evidence" / "learning"
-    for picture in LEARNING:
-        shutil.copy2(args.learning / picture, target / picture)
+    for name in LEARNING_FILES:
+        shutil.copy2(args.learning / name, target / name)
+    for run_name in ("S1", "M1"):
+        for name in LEARNING_RUN_FILES:
+            shutil.copy2(args.learning / run_name / name, target / run_name / name)
 
 
 def make_rl(args: argparse.Namespace) -> None:
     champion = demo_champion(args)
-    run(sys.executable, "examples/rl_figures.py", "--runs", args.rl, "--champion", champion.parent,
-        "--out", DOCS / "rl")
+    made = ROOT / "out" / "rl-figures"  # rl_figures.py writes only into its own folder, never docs/rl
+    run(sys.executable, "examples/rl_figures.py", "--runs", args.rl, "--champion", champion.parent, "--out", made)
+    for picture in RL_FIGURES:
+        shutil.copy2(made / picture, DOCS / "rl" / picture)
     for picture, run_dir in RL_CURVES.items():
         shutil.copy2(args.rl / run_dir / "curve.png", DOCS / "rl" / picture)
 
@@ -132,8 +138,9 @@ STEPS: dict[str, Step] = {
     "random-episode": Step(("random_episode.png",), None, make_random_episode),
     "evolved-team": Step(("evolved_team.png",), "evidence", make_evolved_team),
     "evidence": Step(tuple(f"evidence/{f}" for f in EVIDENCE_FIGURES), "evidence", make_evidence),
-    "learning": Step(tuple(f"evidence/learning/{f}" for f in LEARNING), "learning", make_learning),
     "rl": Step(tuple(f"rl/{f}" for f in (*RL_FIGURES, *RL_CURVES)), "rl", make_rl),
+    "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
+                      "evidence/learning/M1/stats.png"), "learning", make_learning),
 }
 
 
@@ -153,10 +160,10 @@ def main(argv: list[str] | None = None) -> int:
                         help=f"comma-separated steps to run (default: all whose inputs are given): {', '.join(STEPS)}")
     parser.add_argument("--champion", type=Path, default=None,
                         help="champion.json for the gallery (default: make demo's, out/quick/champion.json)")
+    parser.add_argument("--learning", type=Path, default=None,
+                        help="folder of make bench-learning (runs/bench-learning): the learning benchmark's figures")
     parser.add_argument("--evidence", type=Path, default=None,
                         help="folder of the evidence runs (S2-seed1 ... M2-seed2; docs/evidence/README.md)")
-    parser.add_argument("--learning", type=Path, default=None,
-                        help="folder of the learning benchmark's runs (make bench-learning: runs/bench-learning)")
     parser.add_argument("--rl", type=Path, default=None, help="folder of the PPO runs of docs/rl/README.md")
     args = parser.parse_args(argv)
     chosen = list(STEPS) if args.only is None else [s.strip() for s in args.only.split(",") if s.strip()]

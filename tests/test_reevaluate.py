@@ -200,7 +200,8 @@ def test_cache_key_covers_genome_method_world_substrate_and_seeds():
 
     from evolution.analysis.reevaluate import _entry_key
 
-    base = dict(method="hyperneat-m", environment={"environment": 1, "max_cycles": 80}, substrate={})
+    base = dict(method="hyperneat-m", environment={"environment": 1, "max_cycles": 80}, substrate={},
+                complexity="paper")
     genome = {"key": 1, "nodes": [[0, 0.5]]}
     key = _entry_key(genome, SimpleNamespace(**base), [1, 2, 3])
     assert _entry_key(dict(genome), SimpleNamespace(**base), [1, 2, 3]) == key            # same inputs
@@ -209,6 +210,7 @@ def test_cache_key_covers_genome_method_world_substrate_and_seeds():
         (genome, dict(base, method="neat-m"), [1, 2, 3]),                                    # method
         (genome, dict(base, environment={"environment": 1, "max_cycles": 81}), [1, 2, 3]),  # world
         (genome, dict(base, substrate={"hidden_nodes": 2}), [1, 2, 3]),                     # substrate
+        (genome, dict(base, complexity="original"), [1, 2, 3]),                              # eq. 2 variant
         (genome, base, [1, 2]),                                                              # trials
         (genome, base, [1, 2, 4]),                                                           # seeds
     ]
