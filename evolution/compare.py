@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from evolution.guard import ArgumentParser, check_output_dir, command, int_arg
-from evolution.policies import Policy, make_policy
+from evolution.policies import POLICY_NAMES, Policy, make_policy
 from evolution.run.experiment import LIMITS
 from gathering_env import WorldConfig, parallel_env
 
@@ -107,7 +107,7 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser = ArgumentParser(prog="gathering-compare", description=__doc__,
                             formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--policy", action="append", required=True,
-                        help="random | heuristic | wander | champion:PATH | ppo:PATH | ppo-sample:PATH (repeat)")
+                        help=f"{POLICY_NAMES.replace(', ', ' | ')} (repeat)")
     parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3))
     parser.add_argument("--steps", type=int_arg(1, 10**9), default=10_000, help="max_cycles per episode")
     parser.add_argument("--robots", type=int_arg(1, 1000), default=20)
