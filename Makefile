@@ -13,7 +13,7 @@ $(PY):
 
 $(STAMP): pyproject.toml | $(PY)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e ".[dev,video,ray,rl]"
+	$(PY) -m pip install --quiet -e ".[dev,video,ray,rl,marl]"
 	touch $(STAMP)
 
 test: $(STAMP)

@@ -67,7 +67,9 @@ class EpisodeLog(Callback):
 
     def on_batch_collected(self, batch) -> None:
         done = batch.get(("next", "done")).squeeze(-1)          # (worlds, steps)
-        ft = batch.get(("next", "task_performance"))
+        ft = batch.get(("next", "task_performance"), None)
+        if ft is None:                                             # route "wrapper": the infos
+            ft = batch.get(("next", GROUP, "info", "task_performance"))[..., 0]
         steps_before = self.env_steps
         self.env_steps += batch.numel()
         minutes = round((time.perf_counter() - self.start) / 60, 3)
@@ -122,6 +124,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--gamma", type=float_arg(0.0, 1.0, open_low=True), default=0.99)
     p.add_argument("--lmbda", type=float_arg(0.0, 1.0), default=0.95, help="on-policy: GAE lambda")
     p.add_argument("--hidden", type=count, nargs="+", default=[64, 64], help="MLP layer sizes (actor and critic)")
+    p.add_argument("--tanh-normal", action=argparse.BooleanOptionalAction, default=False,
+                   help="on-policy: BenchMARL's default TanhNormal actions (squashed into [-1, 1]) instead of a "
+                        "Gaussian whose samples the env clips, as SB3's PPO (default: Gaussian; docs/rl/README.md)")
     p.add_argument("--seed", type=int_arg(0, 2**31 - 1), default=0)
     p.add_argument("--eval-episodes", type=int_arg(0, 10_000), default=5)
     p.add_argument("--checkpoint-every", type=int_arg(0, float("inf")), default=0,
@@ -140,16 +145,18 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     return args
 
 
-def build_experiment(args: argparse.Namespace, callbacks=()) -> Experiment:
-    """BenchMARL's experiment for the flags (its own task, algorithm, model and experiment configs)."""
+def build_experiment(args: argparse.Namespace, callbacks=(), route: str = "batched") -> Experiment:
+    """BenchMARL's experiment for the flags (its own task, algorithm, model and experiment configs);
+    ``route``: the task's env, ``batched`` (GatheringTorchEnv) or ``wrapper`` (TorchRL's PettingZooWrapper)."""
     task = getattr(GatheringTask, f"ENV{args.environment}").get_from_yaml()
     task.config.update(num_robots=args.robots, max_cycles=args.steps, reward=args.reward,
                        attach_reward=args.attach_reward, reward_scope=args.reward_scope,
-                       reward_scale=args.reward_scale)
+                       reward_scale=args.reward_scale, route=route)
     check_task_config(task.config)
     algorithm = ALGORITHMS[args.algorithm].get_from_yaml()
     if args.algorithm in ON_POLICY:
         algorithm.entropy_coef, algorithm.lmbda = args.entropy, args.lmbda
+        algorithm.use_tanh_normal = args.tanh_normal
     model = MlpConfig(num_cells=list(args.hidden), activation_class=torch.nn.Tanh, layer_class=torch.nn.Linear)
     cfg = ExperimentConfig.get_from_yaml()
     cfg.loggers, cfg.render, cfg.evaluation, cfg.create_json = ["csv"], False, False, True

@@ -162,9 +162,9 @@ def run_example(tmp_path: Path, algorithm: str, *extra: str) -> Path:
     return out
 
 
-@pytest.mark.parametrize("algorithm", ["ippo", "mappo"])
-def test_benchmarl_runs_exports_a_policy_that_replays_and_compares(tmp_path, algorithm, capsys):
-    out = run_example(tmp_path, algorithm)
+@pytest.mark.parametrize("algorithm, extra", [("ippo", ()), ("mappo", ("--tanh-normal",))])
+def test_benchmarl_runs_exports_a_policy_that_replays_and_compares(tmp_path, algorithm, extra, capsys):
+    out = run_example(tmp_path, algorithm, *extra)
     run = json.loads((out / "run.json").read_text())
     assert run["env_steps"] == 160 and run["training_episodes"] == 8   # 2 worlds x 80 steps / 20-step episodes
     rows = (out / "curve.csv").read_text().splitlines()
@@ -180,10 +180,31 @@ def test_benchmarl_runs_exports_a_policy_that_replays_and_compares(tmp_path, alg
     first = sampled.act(obs)
     sampled.reset(3)
     np.testing.assert_array_equal(first, sampled.act(obs))                   # seeded
-    assert np.all(np.abs(first) <= 1) and not np.array_equal(first, policy.act(obs))
+    assert np.isfinite(first).all() and not np.array_equal(first, policy.act(obs))
+    if "--tanh-normal" in extra:
+        assert np.all(np.abs(first) <= 1)            # squashed; Gaussian samples are clipped by the env
     gif = tmp_path / f"{algorithm}.gif"
     assert replay_main([f"benchmarl-sample:{out / 'policy.pt'}", "--steps", "10", "--out", str(gif)]) == 0
     assert gif.stat().st_size > 0 and "environment 1" in capsys.readouterr().out
+
+
+def test_benchmarl_trains_over_torchrls_pettingzoo_wrapper_too(tmp_path):
+    sys.path.insert(0, str(ROOT / "examples"))
+    try:
+        import benchmarl_run
+    finally:
+        sys.path.pop(0)
+    args = benchmarl_run.parse_args(["--algorithm", "mappo", "--robots", "3", "--steps", "10", "--worlds", "2",
+                                     "--env-steps", "40", "--frames-per-batch", "20", "--epochs", "1",
+                                     "--minibatch", "10", "--out", str(tmp_path)])
+    (tmp_path / "benchmarl").mkdir()
+    log = benchmarl_run.EpisodeLog()
+    experiment = benchmarl_run.build_experiment(args, [log], route="wrapper")
+    assert type(experiment.test_env.base_env).__name__ == "PettingZooWrapper"
+    experiment.run()
+    assert experiment.total_frames == 40
+    assert [r["env_steps"] for r in log.rows] == [20, 20, 40, 40]    # 2 worlds x 2 episodes of 10 steps
+    assert "state" in experiment.state_spec.keys()
 
 
 def test_policy_files_of_the_wrong_kind_are_refused(tmp_path, capsys):

@@ -12,9 +12,9 @@ torch, tensordict and TorchRL (and BenchMARL's model classes: ``pip install
 BenchMARL's own checkpoints (``checkpoint_*.pt``: the whole experiment's state) are refused
 with a message saying how to export one.
 
-``benchmarl:PATH`` takes the actor's deterministic action (the mean of its distribution,
-squashed by tanh as in training); ``benchmarl-sample:PATH`` samples actions as in training
-(torch's generator seeded by the episode seed). Loading runs pickle: only load files you wrote.
+``benchmarl:PATH`` takes the actor's deterministic action (the mean of its distribution; with
+TanhNormal actions squashed into [-1, 1], with Gaussian ones clipped by the env);
+``benchmarl-sample:PATH`` samples actions as in training (torch's generator seeded by the episode seed). Loading runs pickle: only load files you wrote.
 """
 
 from __future__ import annotations

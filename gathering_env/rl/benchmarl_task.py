@@ -42,7 +42,10 @@ from .torchrl_env import GROUP, GatheringTorchEnv
 CONFIG_DIR = Path(__file__).parent / "conf"
 """Hydra search-path root holding ``task/gathering/env{1,2,3}.yaml``."""
 
-TASK_ONLY_KEYS = ("reward_scale",)
+TASK_ONLY_KEYS = ("reward_scale", "route")
+ROUTES = ("batched", "wrapper")
+"""``route``: ``batched`` (default) GatheringTorchEnv, all worlds in one call; ``wrapper``: TorchRL's
+``PettingZooWrapper`` around the PettingZoo env, one world each, BenchMARL stacks them in a ``SerialEnv``."""
 
 
 def check_task_config(config: dict[str, Any]) -> dict[str, Any]:
@@ -51,6 +54,8 @@ def check_task_config(config: dict[str, Any]) -> dict[str, Any]:
     scale = config.get("reward_scale", 1.0)
     if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not scale > 0:
         raise ValueError(f"reward_scale={scale!r}; allowed: a number > 0")
+    if config.get("route", "batched") not in ROUTES:
+        raise ValueError(f"route={config.get('route')!r}; allowed: {', '.join(ROUTES)}")
     WorldConfig.from_kwargs(**world)
     return world
 
@@ -64,6 +69,8 @@ class GatheringClass(TaskClass):
             raise ValueError("gathering tasks have continuous wheel commands only; allowed: algorithms with "
                              "continuous actions (ippo, mappo, iddpg, maddpg, isac, masac)")
         world = check_task_config(copy.deepcopy(self.config))
+        if self.config.get("route", "batched") == "wrapper":
+            return lambda: _wrapped_env(world, seed, device)
         return lambda: GatheringTorchEnv(num_worlds=num_envs, seed=seed, device=device, **world)
 
     def supports_continuous_actions(self) -> bool:
@@ -76,13 +83,14 @@ class GatheringClass(TaskClass):
         return False
 
     def max_steps(self, env: EnvBase) -> int:
-        return env.config.max_cycles
+        return int(self.config.get("max_cycles", WorldConfig.max_cycles))
 
     def group_map(self, env: EnvBase) -> dict[str, list[str]]:
         return env.group_map
 
     def observation_spec(self, env: EnvBase) -> Composite:
-        return Composite({GROUP: env.full_observation_spec_unbatched[GROUP].clone()})
+        group = env.full_observation_spec_unbatched[GROUP]
+        return Composite({GROUP: Composite(observation=group["observation"].clone(), shape=group.shape)})
 
     def info_spec(self, env: EnvBase) -> Composite | None:
         return None
@@ -108,12 +116,25 @@ class GatheringClass(TaskClass):
         done = batch.get(("next", "done")).squeeze(-1)
         if not done.any():
             return {}
-        ft = batch.get(("next", "task_performance"))[done]
+        key = ("next", "task_performance")
+        if key not in batch.keys(True):                                     # the wrapper route
+            ft = batch.get(("next", GROUP, "info", "task_performance"))[..., 0][done]
+        else:
+            ft = batch.get(key)[done]
         return {"ft_mean": float(ft.float().mean()), "episodes": float(done.sum())}
 
     @staticmethod
     def env_name() -> str:
         return "gathering"
+
+
+def _wrapped_env(world: dict[str, Any], seed: int | None, device: Any) -> EnvBase:
+    from torchrl.envs import PettingZooWrapper
+
+    from ..env import parallel_env
+
+    return PettingZooWrapper(parallel_env(**world), return_state=True, categorical_actions=False, seed=seed,
+                             device=device)
 
 
 class GatheringTask(Task):
