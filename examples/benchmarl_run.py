@@ -13,10 +13,12 @@ docs/rl/README.md as far as BenchMARL has them)::
     gathering-compare --environment 1 --steps 2000 --policy benchmarl-sample:runs/mappo-env1/policy.pt --policy wander
     gathering-replay benchmarl:runs/mappo-env1/policy.pt --environment 1 --steps 2000 --out mappo.gif
 
-Budgets count environment steps (one step of one world; BenchMARL's frames). Writes into
+Budgets count environment steps (one step of one world; BenchMARL's frames); ``--max-minutes``
+(or a file ``STOP`` created in ``--out``) stops earlier and exports the policy as it is. Writes into
 ``--out``: ``policy.pt`` (the actor, for ``benchmarl:PATH`` / ``benchmarl-sample:PATH``),
 ``curve.csv`` / ``curve.png`` (ft of every finished training episode vs environment steps),
-``run.json`` (settings, minutes, environment steps/s, ft on ``--eval-episodes`` held-out seeds
+``run.json`` (settings, environment steps trained, minutes, environment steps/s, ft on
+``--eval-episodes`` held-out seeds
 10 000 onwards with deterministic and sampled actions) and ``benchmarl/`` (BenchMARL's own
 logs as CSV, and with ``--checkpoint-every`` its checkpoints; ``--resume CHECKPOINT``
 continues a run from one).
@@ -56,14 +58,26 @@ EVAL_SEED = 10_000
 OUTPUTS = ("policy.pt", "curve.csv", "curve.png", "run.json")
 
 
-class EpisodeLog(Callback):
-    """ft of every training episode that ends, with the environment steps and minutes so far."""
+class Stop(Exception):
+    """Training stopped early: ``--max-minutes`` passed or a file ``STOP`` appeared in ``--out``."""
 
-    def __init__(self) -> None:
+
+class EpisodeLog(Callback):
+    """ft of every training episode that ends, with the environment steps and minutes so far;
+    stops training (``Stop``) after ``max_minutes`` or when ``stop_file`` exists."""
+
+    def __init__(self, max_minutes: float | None = None, stop_file: Path | None = None) -> None:
         super().__init__()
         self.rows: list[dict] = []
         self.env_steps = 0
         self.start = time.perf_counter()
+        self.max_minutes, self.stop_file = max_minutes, stop_file
+
+    def on_train_end(self, training_td, group: str) -> None:
+        minutes = (time.perf_counter() - self.start) / 60
+        if (self.max_minutes is not None and minutes >= self.max_minutes) or \
+                (self.stop_file is not None and self.stop_file.exists()):
+            raise Stop(f"stopped after {self.env_steps} environment steps, {minutes:.1f} minutes")
 
     def on_batch_collected(self, batch) -> None:
         done = batch.get(("next", "done")).squeeze(-1)          # (worlds, steps)
@@ -129,6 +143,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         "Gaussian whose samples the env clips, as SB3's PPO (default: Gaussian; docs/rl/README.md)")
     p.add_argument("--seed", type=int_arg(0, 2**31 - 1), default=0)
     p.add_argument("--eval-episodes", type=int_arg(0, 10_000), default=5)
+    p.add_argument("--max-minutes", type=float_arg(0.0, open_low=True), default=None,
+                   help="stop training after this many minutes (also: create a file STOP in --out) and export "
+                        "the policy as it is")
     p.add_argument("--checkpoint-every", type=int_arg(0, float("inf")), default=0,
                    help="save a BenchMARL checkpoint every this many environment steps (0: never)")
     p.add_argument("--resume", type=Path, help="continue from a BenchMARL checkpoint (benchmarl/.../checkpoint_*.pt)")
@@ -191,10 +208,15 @@ def main(argv: list[str] | None = None) -> int:
     if not (args.out / "benchmarl").exists():
         check_output_dir(args.out, OUTPUTS)       # never overwrite anything but an earlier run's output
     (args.out / "benchmarl").mkdir(parents=True, exist_ok=True)   # every input checked: only now touch the disk
-    log = EpisodeLog()
+    (args.out / "STOP").unlink(missing_ok=True)
+    log = EpisodeLog(args.max_minutes, args.out / "STOP")
     experiment = build_experiment(args, [log])
-    start = time.perf_counter()
-    experiment.run()
+    start, stopped = time.perf_counter(), None
+    try:
+        experiment.run()
+    except Stop as stop:
+        stopped = str(stop)
+        print(stopped)
     minutes = (time.perf_counter() - start) / 60
     morphology = Morphology.khepera_iii()
     policy_path = save_policy(args.out / "policy.pt", experiment.group_policies[GROUP], args.algorithm, morphology,
@@ -208,7 +230,7 @@ def main(argv: list[str] | None = None) -> int:
     plot_curve(log.rows, args.out / "curve.png", title)
     run = {"algorithm": args.algorithm, "settings": {k: (str(v) if isinstance(v, Path) else v)
                                                       for k, v in vars(args).items()},
-           "env_steps": experiment.total_frames, "minutes": round(minutes, 2),
+           "env_steps": log.env_steps, "stopped_early": stopped, "minutes": round(minutes, 2),
            "env_steps_per_s": round(log.env_steps / max(minutes * 60, 1e-9), 1),
            "training_episodes": len(log.rows),
            "last_20_episodes_ft": float(np.mean([r["ft"] for r in log.rows[-20:]])) if log.rows else None}

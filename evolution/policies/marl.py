@@ -68,30 +68,43 @@ def read_policy_file(path: str | Path) -> dict[str, Any]:
     return data
 
 
-def benchmarl_policy(path: str, sample: bool = False) -> Policy:
-    """A policy file's actor as a team policy (deterministic, or sampled with ``sample``)."""
+def worlds_actor(data: dict[str, Any], sample: bool = False, path: Any = "policy file"):
+    """``act(obs (W, N, S)) -> wheels (W, N, 2)`` for many worlds at once (one forward pass)."""
     import torch
     from tensordict import TensorDict
     from torchrl.envs.utils import ExplorationType, set_exploration_type
+
+    actor, group, n = data["policy"], data["group"], int(data["num_robots"])
+    actor.eval()
+    mode = ExplorationType.RANDOM if sample else ExplorationType.DETERMINISTIC
+
+    def act(obs: np.ndarray) -> np.ndarray:
+        if obs.shape[1] != n:
+            raise ValueError(f"{path}: the policy was trained for {n} robots, the team has {obs.shape[1]}; "
+                             f"allowed: --robots {n}")
+        w = obs.shape[0]
+        td = TensorDict({group: TensorDict({"observation": torch.as_tensor(obs, dtype=torch.float32)},
+                                           batch_size=(w, n))}, batch_size=(w,))
+        with torch.no_grad(), set_exploration_type(mode):
+            action = actor(td).get((group, "action"))
+        return action.numpy().astype(np.float64)
+
+    return act
+
+
+def benchmarl_policy(path: str, sample: bool = False) -> Policy:
+    """A policy file's actor as a team policy (deterministic, or sampled with ``sample``)."""
+    import torch
 
     data = read_policy_file(path)
     try:
         morphology = Morphology.coerce(data["morphology"])
     except ValueError as err:
         raise ValueError(f"{path}: bad morphology in the policy file ({err})") from None
-    actor, group, n = data["policy"], data["group"], int(data["num_robots"])
-    actor.eval()
-    mode = ExplorationType.RANDOM if sample else ExplorationType.DETERMINISTIC
+    act_worlds = worlds_actor(data, sample, path)
 
     def act(obs: np.ndarray) -> np.ndarray:
-        if obs.shape[0] != n:
-            raise ValueError(f"{path}: the policy was trained for {n} robots, the team has {obs.shape[0]}; "
-                             f"allowed: --robots {n}")
-        td = TensorDict({group: TensorDict({"observation": torch.as_tensor(obs, dtype=torch.float32)[None]},
-                                           batch_size=(1, n))}, batch_size=(1,))
-        with torch.no_grad(), set_exploration_type(mode):
-            action = actor(td).get((group, "action"))
-        return action[0].numpy().astype(np.float64)
+        return act_worlds(obs[None])[0]
 
     def reset(seed):
         if sample:
@@ -106,4 +119,4 @@ def benchmarl_policy(path: str, sample: bool = False) -> Policy:
                   environment=world or None)
 
 
-__all__ = ["FORMAT", "VERSION", "benchmarl_policy", "read_policy_file", "save_policy"]
+__all__ = ["FORMAT", "VERSION", "benchmarl_policy", "read_policy_file", "save_policy", "worlds_actor"]
