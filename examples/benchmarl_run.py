@@ -138,6 +138,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--gamma", type=float_arg(0.0, 1.0, open_low=True), default=0.99)
     p.add_argument("--lmbda", type=float_arg(0.0, 1.0), default=0.95, help="on-policy: GAE lambda")
     p.add_argument("--hidden", type=count, nargs="+", default=[64, 64], help="MLP layer sizes (actor and critic)")
+    p.add_argument("--normalize-advantage", action=argparse.BooleanOptionalAction, default=True,
+                   help="on-policy: standardise the advantages of each minibatch (TorchRL's ClipPPOLoss option; "
+                        "SB3's PPO default; BenchMARL turns it off; default on)")
     p.add_argument("--tanh-normal", action=argparse.BooleanOptionalAction, default=False,
                    help="on-policy: BenchMARL's default TanhNormal actions (squashed into [-1, 1]) instead of a "
                         "Gaussian whose samples the env clips, as SB3's PPO (default: Gaussian; docs/rl/README.md)")
@@ -186,8 +189,12 @@ def build_experiment(args: argparse.Namespace, callbacks=(), route: str = "batch
     cfg.save_folder = str(args.out / "benchmarl")
     cfg.checkpoint_interval, cfg.checkpoint_at_end = args.checkpoint_every, args.checkpoint_every > 0
     cfg.restore_file = None if args.resume is None else str(args.resume)
-    return Experiment(task=task, algorithm_config=algorithm, model_config=model, critic_model_config=model,
-                      seed=args.seed, config=cfg, callbacks=list(callbacks))
+    experiment = Experiment(task=task, algorithm_config=algorithm, model_config=model, critic_model_config=model,
+                            seed=args.seed, config=cfg, callbacks=list(callbacks))
+    if args.algorithm in ON_POLICY:
+        for loss in experiment.losses.values():
+            loss.normalize_advantage = args.normalize_advantage
+    return experiment
 
 
 def evaluate(path: Path, args: argparse.Namespace) -> dict:
