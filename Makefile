@@ -1,5 +1,5 @@
 # make demo           : create .venv if missing, install the core (no torch, no Ray), run the main job
-# make test           : ... install everything the tests import (test extras + RL, Ray, video), run the fast tests
+# make test           : ... install everything the tests import (test extras + RL, MARL, Ray, video), run the fast tests
 # make test-slow      : ... the same install, run the slow tests (CI runs make test, then make test-slow)
 # (With only ".[dev]" installed the RL, Ray and MP4 tests skip; everything else runs.)
 # make bench          : print the environment and generation benchmarks
@@ -24,7 +24,7 @@ $(CORE): pyproject.toml | $(PY)
 	touch $(CORE)
 
 $(ALL): pyproject.toml | $(PY)
-	$(PIP) -e ".[dev,video,ray,rl]"
+	$(PIP) -e ".[dev,video,ray,rl,marl]"
 	touch $(CORE) $(ALL)
 
 test: $(ALL)

@@ -185,15 +185,19 @@ _REPLAY_FLAGS = {"size_px": "--size", "cones": "--cones", "view": "--view", "tra
 
 @command
 def replay_main(argv: list[str] | None = None) -> int:
-    """``gathering-replay CHAMPION.json [--environment N] [--out team.gif] [render options]``."""
+    """``gathering-replay CHAMPION.json|POLICY [--environment N] [--out team.gif] [render options]``."""
+    from evolution.policies import POLICY_NAMES
+
     parser = ArgumentParser(prog="gathering-replay",
-                            description="Replay an evolved team and save the episode as GIF/MP4 "
+                            description="Replay an evolved team or any named policy and save the episode as GIF/MP4 "
                                         "(pictures: --png, --strip, --sensors-png; see docs/rendering.md).")
-    parser.add_argument("champion", type=Path, help="champion JSON written by gathering-evolve")
-    parser.add_argument("--environment", type=int, choices=(1, 2, 3), help="preset (default: the one it evolved in)")
-    parser.add_argument("--steps", type=int_arg(1, 10**9), help="episode length (default: the evolved max_cycles)")
+    parser.add_argument("team", help=f"champion JSON written by gathering-evolve, or a policy name: {POLICY_NAMES}")
+    parser.add_argument("--environment", type=int, choices=(1, 2, 3),
+                        help="preset (default: the one it evolved or was trained in; else 2)")
+    parser.add_argument("--steps", type=int_arg(1, 10**9),
+                        help="episode length (default: the evolved or trained max_cycles; else 10 000)")
     parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0,
-                        help="the episode's seed (default 0): an episode the champion was not trained on")
+                        help="the episode's seed (default 0): an episode the team was not trained on")
     parser.add_argument("--out", type=Path, default=Path("team.gif"), help=".gif or .mp4")
     parser.add_argument("--frame-every", type=int_arg(1, 10**9), default=10, help="record every k-th step")
     parser.add_argument("--fps", type=int_arg(1, 1000), default=15, help="frames per second of the video (default 15)")
@@ -209,6 +213,7 @@ def replay_main(argv: list[str] | None = None) -> int:
     look.add_argument("--sensors-png", type=Path, help="also save the team's sensor layout (like the paper's Figure 3)")
     args = parser.parse_args(argv)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    from evolution.policies import is_policy_name, make_policy
     from evolution.replay import replay, unseen_note
     from evolution.run.champion import load_champion
     from gathering_env.render import RenderOptionError
@@ -225,22 +230,30 @@ def replay_main(argv: list[str] | None = None) -> int:
     for picture, flag in ((args.png, "--png"), (args.sensors_png, "--sensors-png")):
         if picture is not None:
             check_output_file(picture, (".png",), flag)
-    champion = load_champion(args.champion)
-    env_config = dict(champion.environment)
+    if is_policy_name(args.team):
+        team = make_policy(args.team)
+        env_config, label = dict(team.environment or {}), f"{team.name} ({len(team.morphology)} sensors)"
+    else:
+        if not Path(args.team).exists():
+            raise UsageError(f"{args.team}: neither a champion file nor a policy name; allowed: a champion JSON "
+                             f"written by gathering-evolve, or {POLICY_NAMES}")
+        team = load_champion(Path(args.team))
+        env_config = dict(team.environment)
+        label = f"{team.experiment or 'champion'} ({team.method}, {len(team.morphology)} sensors)"
     if args.environment is not None:
         env_config["environment"] = args.environment
     if args.steps is not None:
         env_config["max_cycles"] = args.steps
     try:
-        info, path, frames = replay(champion, env_config, args.seed, args.out, args.frame_every, args.fps,
+        info, path, frames = replay(team, env_config, args.seed, args.out, args.frame_every, args.fps,
                                     png=args.png, render_options=render_options, strip=args.strip,
                                     sensors_png=args.sensors_png)
     except RenderOptionError as err:
         raise UsageError(f"{_REPLAY_FLAGS.get(err.option, err.option)}: {err.problem}; allowed: {err.allowed}") from None
-    print(f"{champion.experiment or 'champion'} ({champion.method}, {len(champion.morphology)} sensors) in "
-          f"environment {env_config.get('environment')}: ft = {info['task_performance']:.2f}, gathered "
+    print(f"{label} in environment {env_config.get('environment', 2)}: ft = {info['task_performance']:.2f}, gathered "
           f"{info['gathered_value']:.0f}/{info['total_value']:.0f} in {info['steps']} steps")
-    print(unseen_note(champion, env_config, args.seed))
+    if not is_policy_name(args.team):
+        print(unseen_note(team, env_config, args.seed))
     print(f"wrote {path} ({frames} frames)")
     for picture in (args.png, args.sensors_png):
         if picture is not None:

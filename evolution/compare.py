@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from evolution.guard import ArgumentParser, check_output_dir, command, int_arg, writing
-from evolution.policies import Policy, make_policy
+from evolution.policies import POLICY_NAMES, Policy, make_policy
 from evolution.run.experiment import LIMITS
 from gathering_env import WorldConfig, parallel_env
 
@@ -117,7 +117,7 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser = ArgumentParser(prog="gathering-compare", description=__doc__,
                             formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--policy", action="append", required=True,
-                        help="random | heuristic | wander | champion:PATH | ppo:PATH | ppo-sample:PATH (repeat)")
+                        help=f"{POLICY_NAMES.replace(', ', ' | ')} (repeat)")
     parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3),
                         help="environment preset (paper Table 2; default 2)")
     parser.add_argument("--steps", type=int_arg(1, 10**9), default=10_000, help="max_cycles per episode")

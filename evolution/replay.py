@@ -1,4 +1,7 @@
-"""Replay a champion's team in the environment and record it: video, picture, film strip, sensors."""
+"""Replay a team in the environment and record it: video, picture, film strip, sensors.
+
+The team is an evolved champion or any named policy of ``evolution.policies`` (``wander``,
+``ppo:PATH``, ``benchmarl-sample:PATH``, ...), so a trained policy can be watched like an evolved team."""
 
 from __future__ import annotations
 
@@ -8,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from evolution.policies import Policy
 from evolution.run.champion import Champion
 from gathering_env import parallel_env
 from gathering_env.render import RenderOptionError, VideoWriter, film_strip, save_png, sensor_layout
@@ -33,16 +37,18 @@ def parse_steps(value: str | Sequence[int], max_cycles: int) -> list[int]:
     return [int(s) for s in steps]
 
 
-def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
+def replay(team: Champion | Policy, env_config: dict[str, Any], seed: int, out: Path,
            frame_every: int = 10, fps: int = 15, png: Path | None = None,
            render_options: dict[str, Any] | None = None, strip: str | Sequence[int] | None = None,
            sensors_png: Path | None = None) -> tuple[dict[str, Any], Path, int]:
-    """Run one episode of the champion's team with rendering; returns (final info, video path, frames).
+    """Run one episode of the team with rendering; returns (final info, video path, frames).
 
     Frames are streamed to the video file as they are drawn (``VideoWriter``: memory does not
     grow with the episode); the file appears only once complete, so a failure leaves none.
 
     Args:
+        team: a champion or a ``Policy`` (``evolution.policies.make_policy``); its ``reset(seed)``
+            is called before the episode.
         render_options: what the frames show (``gathering_env.render``: cones, view, size_px,
             trail, panel, min_robot_px).
         png: also save a picture there: the last frame, or with ``strip`` a film strip.
@@ -60,11 +66,14 @@ def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
     steps = parse_steps(strip, env.config.max_cycles) if strip is not None else []
     if steps and png is None:
         raise RenderOptionError("strip", "a film strip needs a picture file", "--png FILE.png with --strip")
+    if isinstance(team, Champion):
+        label = f"{team.experiment or 'champion'} ({team.method})"
+        team = Policy(label, team.morphology, team.controller.act)
     if sensors_png is not None:
-        title = f"{champion.experiment or 'champion'} ({champion.method}): sensors of every robot"
-        save_png(sensor_layout(champion.morphology, title=title), sensors_png)
+        save_png(sensor_layout(team.morphology, title=f"{team.name}: sensors of every robot"), sensors_png)
     video = VideoWriter(out, fps=fps)  # checks the suffix and fps before the episode
-    obs_dict, _ = env.reset(seed=seed, options={"morphology": champion.morphology})
+    obs_dict, _ = env.reset(seed=seed, options={"morphology": team.morphology})
+    team.reset(seed)
     obs = np.stack([obs_dict[a] for a in env.possible_agents])
     panels: dict[int, np.ndarray] = {}
     captions: dict[int, str] = {}
@@ -81,7 +90,7 @@ def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
             snap(0)
         step = 0
         while env.agents:
-            obs, _, terminated, truncated = env.step_batch(champion.controller.act(obs))
+            obs, _, terminated, truncated = env.step_batch(np.asarray(team.act(obs), dtype=np.float64))
             step += 1
             if step % frame_every == 0 or terminated or truncated:
                 last = env.render()

@@ -42,9 +42,7 @@ from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvIndices
 
 from ..sensors import Morphology
 from ..vector import VectorSimulation
-
-SEED_LIMIT = 2**31
-"""Episode seeds are drawn uniformly from [0, SEED_LIMIT)."""
+from .seeds import SEED_LIMIT, check_seed, episode_seeds
 
 MAX_WHEEL_LEVELS = 101
 """Upper bound on ``wheel_levels`` (commands per wheel of the discrete action space)."""
@@ -139,7 +137,7 @@ class GatheringVecEnv(VecEnv):
         self.num_worlds, self.num_robots = self.sim.num_worlds, self.config.num_robots
         observation_space = spaces.Box(0.0, 1.0, shape=(len(self.sim.morphology),), dtype=np.float32)
         super().__init__(self.num_worlds * self.num_robots, observation_space, actions)
-        self._seed = _check_seed(seed)
+        self._seed = check_seed(seed)
         self._rng = np.random.default_rng(self._seed)
         self._actions: np.ndarray | None = None
         self._team_return = np.zeros(self.num_worlds)
@@ -147,7 +145,7 @@ class GatheringVecEnv(VecEnv):
     # ------------------------------------------------------------------ VecEnv API
     def seed(self, seed: int | None = None) -> list[int | None]:
         """Seed the episode-seed generator; takes effect at the next ``reset()``."""
-        self._seed = _check_seed(seed)
+        self._seed = check_seed(seed)
         self._rng = np.random.default_rng(self._seed)
         return [self._seed] * self.num_envs
 
@@ -203,7 +201,7 @@ class GatheringVecEnv(VecEnv):
 
     # ------------------------------------------------------------------ helpers
     def _episode_seeds(self, count: int) -> list[int]:
-        return [int(s) for s in self._rng.integers(0, SEED_LIMIT, count)]
+        return episode_seeds(self._rng, count)
 
     def _indices(self, indices: VecEnvIndices) -> list[int]:
         if indices is None:
@@ -213,10 +211,4 @@ class GatheringVecEnv(VecEnv):
         return list(indices)
 
 
-def _check_seed(seed: Any) -> int | None:
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0):
-        raise ValueError(f"seed={seed!r}; allowed: a non-negative integer or None")
-    return None if seed is None else int(seed)
-
-
-__all__ = ["GatheringVecEnv", "action_space", "check_actions", "wheel_commands"]
+__all__ = ["SEED_LIMIT", "GatheringVecEnv", "action_space", "check_actions", "wheel_commands"]
