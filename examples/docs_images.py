@@ -55,7 +55,7 @@ RL_FIGURES = tuple(f"compare-env{e}-{s}.png" for e in (1, 2) for s in (2000, 100
 @dataclass(frozen=True)
 class Step:
     outputs: tuple[str, ...]        # pictures, relative to docs/
-    needs: str | None               # None, "evidence", "rl" or "learning"
+    needs: str | None               # None, "evidence", "rl", "marl" or "learning"
     make: Callable[[argparse.Namespace], None]
 
 
@@ -108,6 +108,12 @@ def make_evidence(args: argparse.Namespace) -> None:
             shutil.copy2(produced, DOCS / "evidence" / produced.name)
 
 
+def make_marl(args: argparse.Namespace) -> None:
+    """The IPPO / MAPPO comparison of docs/rl/README.md from BenchMARL runs (``--marl DIR`` of
+    ``examples/benchmarl_run.py`` outputs; training them takes hours)."""
+    run(sys.executable, "examples/marl_figures.py", "--runs", args.marl, "--out", DOCS / "rl")
+
+
 LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
 LEARNING_RUN_FILES = ("stats.png", "stats.jsonl", "stats.csv", "experiment.json", "champion.json")
 
@@ -139,6 +145,7 @@ STEPS: dict[str, Step] = {
     "evolved-team": Step(("evolved_team.png",), "evidence", make_evolved_team),
     "evidence": Step(tuple(f"evidence/{f}" for f in EVIDENCE_FIGURES), "evidence", make_evidence),
     "rl": Step(tuple(f"rl/{f}" for f in (*RL_FIGURES, *RL_CURVES)), "rl", make_rl),
+    "marl": Step(("rl/curves-marl-env1.png",), "marl", make_marl),
     "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
                       "evidence/learning/M1/stats.png"), "learning", make_learning),
 }
@@ -160,6 +167,8 @@ def main(argv: list[str] | None = None) -> int:
                         help=f"comma-separated steps to run (default: all whose inputs are given): {', '.join(STEPS)}")
     parser.add_argument("--champion", type=Path, default=None,
                         help="champion.json for the gallery (default: make demo's, out/quick/champion.json)")
+    parser.add_argument("--marl", type=Path, default=None,
+                        help="folder of the BenchMARL runs (examples/benchmarl_run.py): the IPPO/MAPPO figures")
     parser.add_argument("--learning", type=Path, default=None,
                         help="folder of make bench-learning (runs/bench-learning): the learning benchmark's figures")
     parser.add_argument("--evidence", type=Path, default=None,
