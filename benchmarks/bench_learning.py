@@ -199,7 +199,8 @@ def main(argv: list[str] | None = None) -> int:
     policies.update({"wander": "wander", "random": "random"})
     print(f"\nheld-out ft on {len(seeds)} layouts of environment {exp.environment['environment']}:", flush=True)
     scores = heldout_scores(policies, args, seeds)
-    data = {"budget": budget, "seeds": seeds, "policies": {k: str(v) for k, v in policies.items()},
+    relative = {k: v.replace(f"{args.out}{os.sep}", "") for k, v in policies.items()}  # no machine's paths
+    data = {"budget": budget, "seeds": seeds, "policies": relative,
             "curves": {name: curves(path) for name, path in runs.items()}, "scores": scores,
             "paired": paired(scores)}
     for name in EXPERIMENTS:

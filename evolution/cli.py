@@ -83,20 +83,26 @@ def evolve_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--max-retries", type=int_arg(0, 100), default=2,
                         help="retries of a failing evaluation (default 2)")
     group = parser.add_argument_group("overrides of the experiment file")
-    group.add_argument("--name")
+    group.add_argument("--name", help="the run's name ([experiment] name; default run folder runs/<name>-seed<seed>)")
     group.add_argument("--protocol", choices=PROTOCOLS,
                        help="a named bundle of world and method options (docs/fidelity.md); "
                             "'original' = the 2018 code behind the published figures")
-    group.add_argument("--method", choices=METHODS)
-    group.add_argument("--objectives", help="comma-separated: task,morphology,controller")
-    group.add_argument("--seed", type=int_arg(*LIMITS["seed"]))
-    group.add_argument("--generations", type=int_arg(*LIMITS["generations"]))
-    group.add_argument("--population", type=int_arg(*LIMITS["population"]))
-    group.add_argument("--trials", type=int_arg(*LIMITS["trials"]))
-    group.add_argument("--environment", type=int, help="environment preset 1, 2 or 3")
+    group.add_argument("--method", choices=METHODS, help="hyperneat-m (CPPN) or neat-m (direct encoding)")
+    group.add_argument("--objectives", help="comma-separated, all maximised: task (ft), morphology (simplicity C), "
+                                             "controller (100 - links); more than one = NEAT-MODS")
+    group.add_argument("--seed", type=int_arg(*LIMITS["seed"]),
+                       help="run seed: every random choice of the run flows from it")
+    group.add_argument("--generations", type=int_arg(*LIMITS["generations"]), help="generations to evolve")
+    group.add_argument("--population", type=int_arg(*LIMITS["population"]), help="genomes per generation")
+    group.add_argument("--trials", type=int_arg(*LIMITS["trials"]),
+                       help="episodes per genome; its fitness is their mean ft")
+    group.add_argument("--environment", type=int, help="environment preset 1, 2 or 3 (paper Table 2)")
     group.add_argument("--steps", type=int, help="steps per trial (max_cycles)")
     group.add_argument("--robots", type=int, help="team size (num_robots)")
     args = parser.parse_args(argv)
+    if args.ray_address is not None and args.backend != "ray":
+        raise UsageError(f"--ray-address {args.ray_address}: only used with --backend ray (the backend is "
+                         f"{args.backend}); allowed: add --backend ray, or drop --ray-address")
     if args.list:
         return _list_presets()
     if args.dump is not None:
@@ -179,17 +185,22 @@ _REPLAY_FLAGS = {"size_px": "--size", "cones": "--cones", "view": "--view", "tra
 
 @command
 def replay_main(argv: list[str] | None = None) -> int:
-    """``gathering-replay CHAMPION.json [--environment N] [--out team.gif] [render options]``."""
+    """``gathering-replay CHAMPION.json|POLICY [--environment N] [--out team.gif] [render options]``."""
+    from evolution.policies import POLICY_NAMES
+
     parser = ArgumentParser(prog="gathering-replay",
-                            description="Replay an evolved team and save the episode as GIF/MP4 "
+                            description="Replay an evolved team or any named policy and save the episode as GIF/MP4 "
                                         "(pictures: --png, --strip, --sensors-png; see docs/rendering.md).")
-    parser.add_argument("champion", type=Path, help="champion JSON written by gathering-evolve")
-    parser.add_argument("--environment", type=int, choices=(1, 2, 3), help="preset (default: the one it evolved in)")
-    parser.add_argument("--steps", type=int_arg(1, 10**9), help="episode length (default: the evolved max_cycles)")
-    parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0)
+    parser.add_argument("team", help=f"champion JSON written by gathering-evolve, or a policy name: {POLICY_NAMES}")
+    parser.add_argument("--environment", type=int, choices=(1, 2, 3),
+                        help="preset (default: the one it evolved or was trained in; else 2)")
+    parser.add_argument("--steps", type=int_arg(1, 10**9),
+                        help="episode length (default: the evolved or trained max_cycles; else 10 000)")
+    parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0,
+                        help="the episode's seed (default 0): an episode the team was not trained on")
     parser.add_argument("--out", type=Path, default=Path("team.gif"), help=".gif or .mp4")
     parser.add_argument("--frame-every", type=int_arg(1, 10**9), default=10, help="record every k-th step")
-    parser.add_argument("--fps", type=int_arg(1, 1000), default=15)
+    parser.add_argument("--fps", type=int_arg(1, 1000), default=15, help="frames per second of the video (default 15)")
     parser.add_argument("--png", type=Path, help="also save the last frame (or with --strip a film strip) as PNG")
     look = parser.add_argument_group("what the frames show (docs/rendering.md)")
     look.add_argument("--cones", help="whose sensor cones: auto (default), all, none or robot indices like 0,3")
@@ -202,7 +213,8 @@ def replay_main(argv: list[str] | None = None) -> int:
     look.add_argument("--sensors-png", type=Path, help="also save the team's sensor layout (like the paper's Figure 3)")
     args = parser.parse_args(argv)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    from evolution.replay import replay
+    from evolution.policies import is_policy_name, make_policy
+    from evolution.replay import replay, unseen_note
     from evolution.run.champion import load_champion
     from gathering_env.render import RenderOptionError
 
@@ -212,24 +224,36 @@ def replay_main(argv: list[str] | None = None) -> int:
     if args.no_panel:
         render_options["panel"] = False
     check_output_file(args.out, (".gif", ".mp4"), "--out")
+    if args.png is not None and args.sensors_png is not None and args.png.resolve() == args.sensors_png.resolve():
+        raise UsageError(f"--sensors-png {args.sensors_png}: the same file as --png (one would overwrite the "
+                         "other); allowed: two different file names")
     for picture, flag in ((args.png, "--png"), (args.sensors_png, "--sensors-png")):
         if picture is not None:
             check_output_file(picture, (".png",), flag)
-    champion = load_champion(args.champion)
-    env_config = dict(champion.environment)
+    if is_policy_name(args.team):
+        team = make_policy(args.team)
+        env_config, label = dict(team.environment or {}), f"{team.name} ({len(team.morphology)} sensors)"
+    else:
+        if not Path(args.team).exists():
+            raise UsageError(f"{args.team}: neither a champion file nor a policy name; allowed: a champion JSON "
+                             f"written by gathering-evolve, or {POLICY_NAMES}")
+        team = load_champion(Path(args.team))
+        env_config = dict(team.environment)
+        label = f"{team.experiment or 'champion'} ({team.method}, {len(team.morphology)} sensors)"
     if args.environment is not None:
         env_config["environment"] = args.environment
     if args.steps is not None:
         env_config["max_cycles"] = args.steps
     try:
-        info, path, frames = replay(champion, env_config, args.seed, args.out, args.frame_every, args.fps,
+        info, path, frames = replay(team, env_config, args.seed, args.out, args.frame_every, args.fps,
                                     png=args.png, render_options=render_options, strip=args.strip,
                                     sensors_png=args.sensors_png)
     except RenderOptionError as err:
         raise UsageError(f"{_REPLAY_FLAGS.get(err.option, err.option)}: {err.problem}; allowed: {err.allowed}") from None
-    print(f"{champion.experiment or 'champion'} ({champion.method}, {len(champion.morphology)} sensors) in "
-          f"environment {env_config.get('environment')}: ft = {info['task_performance']:.2f}, gathered "
+    print(f"{label} in environment {env_config.get('environment', 2)}: ft = {info['task_performance']:.2f}, gathered "
           f"{info['gathered_value']:.0f}/{info['total_value']:.0f} in {info['steps']} steps")
+    if not is_policy_name(args.team):
+        print(unseen_note(team, env_config, args.seed))
     print(f"wrote {path} ({frames} frames)")
     for picture in (args.png, args.sensors_png):
         if picture is not None:
@@ -259,7 +283,7 @@ def analyze_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--backend", choices=BACKENDS, default="process",
                         help="where --reevaluate runs (default: process pool)")
     args = parser.parse_args(argv)
-    from evolution.analysis.fronts import analyse
+    from evolution.analysis.fronts import analyse, nothing_to_compare
     from evolution.analysis.report import REPORT_FILES, write_report
     from evolution.guard import check_output_dir
 
@@ -267,6 +291,9 @@ def analyze_main(argv: list[str] | None = None) -> int:
     analysis = analyse(args.runs, reevaluate=args.reevaluate, workers=args.workers, backend=args.backend)
     path = write_report(analysis, args.out)
     print(f"{len(analysis.runs)} runs, {len(analysis.comparisons)} comparisons -> {path}")
+    untested = sorted({c.untested for c in analysis.comparisons if c.untested})
+    for line in filter(None, [nothing_to_compare(analysis), *untested]):
+        print(line)
     print(f"ft used: {analysis.scores}")
     return 0
 

@@ -2,7 +2,7 @@
 
 ``gathering-compare --policy random --policy heuristic --policy wander --policy champion:run/champion.json
 --policy ppo:ppo/model.zip --environment 2 --episodes 5 --out compare/`` runs every policy on
-the same environment and episode seeds and writes ``compare.md`` / ``compare.csv`` (mean +- std
+the same environment and episode seeds and writes ``compare.md`` / ``compare.csv`` (mean ± standard error of
 ft, blocks gathered by type, time to finish) and ``compare.png`` (a bar plot).
 
 Policies: ``evolution.policies`` (the names ``--policy`` takes are listed there).
@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from evolution.guard import ArgumentParser, check_output_dir, command, int_arg
-from evolution.policies import Policy, make_policy
+from evolution.guard import ArgumentParser, check_output_dir, command, int_arg, writing
+from evolution.policies import POLICY_NAMES, Policy, make_policy
 from evolution.run.experiment import LIMITS
 from gathering_env import WorldConfig, parallel_env
 
@@ -43,7 +43,9 @@ def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
 
 
 def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]) -> list[dict[str, Any]]:
-    """One row per policy: mean/std ft, mean blocks by type, mean steps to finish, finished count."""
+    """One row per policy: ft's mean, standard deviation (``ft_std``, ddof 0) and standard error
+    of the mean (``ft_se`` = sample std / sqrt(episodes), None for one episode), mean blocks by
+    type, mean steps to finish, finished count."""
     env = parallel_env(**env_config)
     rows = []
     seen: dict[str, int] = {}
@@ -56,12 +58,17 @@ def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]
         done = [e["steps"] for e in episodes if e["finished"]]
         rows.append({
             "policy": name, "sensors": len(policy.morphology), "episodes": len(seeds),
-            "ft_mean": float(ft.mean()), "ft_std": float(ft.std()),
+            "ft_mean": float(ft.mean()), "ft_std": float(ft.std()), "ft_se": standard_error(ft),
             "small": float(by_type[:, 0].mean()), "medium": float(by_type[:, 1].mean()),
             "large": float(by_type[:, 2].mean()),
             "finished": len(done), "steps_to_finish": float(np.mean(done)) if done else None,
         })
     return rows
+
+
+def standard_error(sample: np.ndarray) -> float | None:
+    """Standard error of the mean, std(ddof=1) / sqrt(n); None for fewer than two values."""
+    return float(sample.std(ddof=1) / np.sqrt(len(sample))) if len(sample) > 1 else None
 
 
 #: Every file ``write_outputs`` writes: the output folder may hold these (an earlier
@@ -78,26 +85,29 @@ def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Pa
     check_output_dir(out, COMPARE_FILES)
     out.mkdir(parents=True, exist_ok=True)
     csv_path = out / "compare.csv"
-    with open(csv_path, "w", newline="") as f:
+    with writing(csv_path), open(csv_path, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
-    lines = ["| policy | sensors | ft (mean ± std) | small | medium | large | finished | steps to finish |",
+    lines = ["| policy | sensors | ft (mean ± standard error) | small | medium | large | finished | steps to finish |",
              "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         steps = f"{r['steps_to_finish']:.0f}" if r["steps_to_finish"] is not None else "—"
-        lines.append(f"| {r['policy']} | {r['sensors']} | {r['ft_mean']:.2f} ± {r['ft_std']:.2f} | {r['small']:.1f} | "
+        se = f" ± {r['ft_se']:.2f}" if r["ft_se"] is not None else " (one episode: no error)"
+        lines.append(f"| {r['policy']} | {r['sensors']} | {r['ft_mean']:.2f}{se} | {r['small']:.1f} | "
                      f"{r['medium']:.1f} | {r['large']:.1f} | {r['finished']}/{r['episodes']} | {steps} |")
     md_path = out / "compare.md"
-    md_path.write_text(f"{title}\n\n" + "\n".join(lines) + "\n")
+    with writing(md_path):
+        md_path.write_text(f"{title}\n\n" + "\n".join(lines) + "\n")
     fig, ax = plt.subplots(figsize=(1.6 + 1.3 * len(rows), 3.6), constrained_layout=True)
-    ax.bar(range(len(rows)), [r["ft_mean"] for r in rows], yerr=[r["ft_std"] for r in rows], capsize=4,
+    ax.bar(range(len(rows)), [r["ft_mean"] for r in rows], yerr=[r["ft_se"] or 0.0 for r in rows], capsize=4,
            color="tab:blue")
     ax.set_xticks(range(len(rows)), [r["policy"] for r in rows], rotation=15, fontsize=8)
-    ax.set_ylabel("task performance ft")
+    ax.set_ylabel("task performance ft (mean ± standard error)")
     ax.set_title(title, fontsize=9)
     png_path = out / "compare.png"
-    fig.savefig(png_path, dpi=110)
+    with writing(png_path):
+        fig.savefig(png_path, dpi=110)
     plt.close(fig)
     return md_path, csv_path, png_path
 
@@ -107,13 +117,15 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser = ArgumentParser(prog="gathering-compare", description=__doc__,
                             formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--policy", action="append", required=True,
-                        help="random | heuristic | wander | champion:PATH | ppo:PATH | ppo-sample:PATH (repeat)")
-    parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3))
+                        help=f"{POLICY_NAMES.replace(', ', ' | ')} (repeat)")
+    parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3),
+                        help="environment preset (paper Table 2; default 2)")
     parser.add_argument("--steps", type=int_arg(1, 10**9), default=10_000, help="max_cycles per episode")
-    parser.add_argument("--robots", type=int_arg(1, 1000), default=20)
+    parser.add_argument("--robots", type=int_arg(1, 1000), default=20, help="team size (default 20)")
     parser.add_argument("--episodes", type=int_arg(1, 10_000), default=5, help="episodes (seeds 0..n-1) per policy")
     parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0, help="first episode seed")
-    parser.add_argument("--out", type=Path, default=Path("compare"))
+    parser.add_argument("--out", type=Path, default=Path("compare"),
+                        help="folder for compare.md, compare.csv, compare.png (default compare/)")
     args = parser.parse_args(argv)
     check_output_dir(args.out, COMPARE_FILES)
     env_config = {"environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots}

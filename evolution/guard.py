@@ -15,13 +15,15 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import errno
 import functools
 import math
 import os
 import re
 import sys
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 
@@ -39,9 +41,30 @@ def fail(message: str) -> int:
 
 
 def describe_os_error(err: OSError) -> str:
-    where = err.filename if err.filename is not None else "file system"
-    reason = err.strerror or type(err).__name__
-    return f"{where}: {reason.lower()}; allowed: a path you can read and write (check it and its permissions)"
+    """``<file>: <reason>; allowed: ...`` (writes go through ``writing(path)``, so the file is known)."""
+    where = err.filename if err.filename is not None else "file system (file unknown)"
+    reason = (err.strerror or str(err) or type(err).__name__).lower()
+    if err.errno in (errno.ENOSPC, errno.EDQUOT):
+        allowed = "free space on that disk (or another --out)"
+    elif err.errno == errno.EFBIG:
+        allowed = "a file size within the limit (ulimit -f) or another location"
+    else:
+        allowed = "a path you can read and write (check it and its permissions)"
+    return f"{where}: {reason}; allowed: {allowed}"
+
+
+@contextlib.contextmanager
+def writing(path: Path | str) -> Iterator[None]:
+    """An ``OSError`` raised inside (a full disk, a file too large) names ``path`` if it named no file.
+
+    ``write()``, ``flush()``, ``fsync()`` and ``close()`` errors carry no file name of their own.
+    """
+    try:
+        yield
+    except OSError as err:
+        if err.filename is not None:
+            raise
+        raise OSError(err.errno, err.strerror or str(err) or type(err).__name__, str(path)) from None
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:  # noqa: ANN001

@@ -1,4 +1,7 @@
-"""Replay a champion's team in the environment and record it: video, picture, film strip, sensors."""
+"""Replay a team in the environment and record it: video, picture, film strip, sensors.
+
+The team is an evolved champion or any named policy of ``evolution.policies`` (``wander``,
+``ppo:PATH``, ``benchmarl-sample:PATH``, ...), so a trained policy can be watched like an evolved team."""
 
 from __future__ import annotations
 
@@ -8,9 +11,10 @@ from typing import Any
 
 import numpy as np
 
+from evolution.policies import Policy
 from evolution.run.champion import Champion
 from gathering_env import parallel_env
-from gathering_env.render import RenderOptionError, film_strip, save_png, save_video, sensor_layout
+from gathering_env.render import RenderOptionError, VideoWriter, film_strip, save_png, sensor_layout
 
 
 def parse_steps(value: str | Sequence[int], max_cycles: int) -> list[int]:
@@ -33,13 +37,18 @@ def parse_steps(value: str | Sequence[int], max_cycles: int) -> list[int]:
     return [int(s) for s in steps]
 
 
-def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
+def replay(team: Champion | Policy, env_config: dict[str, Any], seed: int, out: Path,
            frame_every: int = 10, fps: int = 15, png: Path | None = None,
            render_options: dict[str, Any] | None = None, strip: str | Sequence[int] | None = None,
            sensors_png: Path | None = None) -> tuple[dict[str, Any], Path, int]:
-    """Run one episode of the champion's team with rendering; returns (final info, video path, frames).
+    """Run one episode of the team with rendering; returns (final info, video path, frames).
+
+    Frames are streamed to the video file as they are drawn (``VideoWriter``: memory does not
+    grow with the episode); the file appears only once complete, so a failure leaves none.
 
     Args:
+        team: a champion or a ``Policy`` (``evolution.policies.make_policy``); its ``reset(seed)``
+            is called before the episode.
         render_options: what the frames show (``gathering_env.render``: cones, view, size_px,
             trail, panel, min_robot_px).
         png: also save a picture there: the last frame, or with ``strip`` a film strip.
@@ -57,12 +66,15 @@ def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
     steps = parse_steps(strip, env.config.max_cycles) if strip is not None else []
     if steps and png is None:
         raise RenderOptionError("strip", "a film strip needs a picture file", "--png FILE.png with --strip")
+    if isinstance(team, Champion):
+        label = f"{team.experiment or 'champion'} ({team.method})"
+        team = Policy(label, team.morphology, team.controller.act)
     if sensors_png is not None:
-        title = f"{champion.experiment or 'champion'} ({champion.method}): sensors of every robot"
-        save_png(sensor_layout(champion.morphology, title=title), sensors_png)
-    obs_dict, _ = env.reset(seed=seed, options={"morphology": champion.morphology})
+        save_png(sensor_layout(team.morphology, title=f"{team.name}: sensors of every robot"), sensors_png)
+    video = VideoWriter(out, fps=fps)  # checks the suffix and fps before the episode
+    obs_dict, _ = env.reset(seed=seed, options={"morphology": team.morphology})
+    team.reset(seed)
     obs = np.stack([obs_dict[a] for a in env.possible_agents])
-    frames = [env.render()]
     panels: dict[int, np.ndarray] = {}
     captions: dict[int, str] = {}
 
@@ -71,24 +83,44 @@ def replay(champion: Champion, env_config: dict[str, Any], seed: int, out: Path,
         panels[step] = env.render(panel=False)
         captions[step] = f"step {sim.steps}: value {sim.gathered_value:g} / {sim.total_value:g}"
 
-    if 0 in steps:
-        snap(0)
-    step = 0
-    while env.agents:
-        obs, _, terminated, truncated = env.step_batch(champion.controller.act(obs))
-        step += 1
-        if step % frame_every == 0 or terminated or truncated:
-            frames.append(env.render())
-        if step in steps:
-            snap(step)
-    for s in steps:                                  # the episode ended before these steps
-        if s not in panels:
-            snap(s)
+    with video:
+        last = env.render()
+        video.add(last)
+        if 0 in steps:
+            snap(0)
+        step = 0
+        while env.agents:
+            obs, _, terminated, truncated = env.step_batch(np.asarray(team.act(obs), dtype=np.float64))
+            step += 1
+            if step % frame_every == 0 or terminated or truncated:
+                last = env.render()
+                video.add(last)
+            if step in steps:
+                snap(step)
+        for s in steps:                                  # the episode ended before these steps
+            if s not in panels:
+                snap(s)
     info = env.team_info()
     env.close()
     if png is not None:
         if steps:
             save_png(film_strip([panels[s] for s in steps], [captions[s] for s in steps]), png)
         else:
-            save_png(frames[-1], png)
-    return info, save_video(frames, out, fps=fps), len(frames)
+            save_png(last, png)
+    return info, Path(out), video.frames
+
+
+def unseen_note(champion: Champion, env_config: dict[str, Any], seed: int) -> str:
+    """One line saying how the replayed episode relates to the champion's training score.
+
+    A champion's ``task`` objective is its mean ft over the trial episodes of training, drawn
+    from the run's seed; a replay runs the episode of ``seed``, which is none of them, so its ft
+    is a single unseen episode and may be far from the training score."""
+    trained = champion.objectives.get("task")
+    if trained is None:
+        return f"an unseen episode (seed {seed}): the champion file holds no training ft to compare with"
+    changed = [key for key in ("environment", "max_cycles", "num_robots")
+               if key in env_config and env_config[key] != champion.environment.get(key, env_config[key])]
+    world = f" in a changed world ({', '.join(changed)})" if changed else ""
+    return (f"an unseen episode (seed {seed}){world}: the training ft {trained:.2f} is the mean over the "
+            f"run's own trial episodes; one new episode can score far from it")

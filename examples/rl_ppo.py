@@ -45,13 +45,22 @@ from stable_baselines3.common.logger import configure  # noqa: E402
 from stable_baselines3.common.vec_env import VecMonitor, VecNormalize  # noqa: E402
 
 from evolution.compare import compare
-from evolution.guard import ArgumentParser, check_output_dir, command, float_arg, int_arg  # noqa: E402
+from evolution.guard import (  # noqa: E402
+    ArgumentParser,
+    UsageError,
+    check_output_dir,
+    command,
+    float_arg,
+    int_arg,
+    writing,
+)
 from evolution.policies.learned import ppo_policy  # noqa: E402
 from evolution.run.champion import load_champion  # noqa: E402
 from gathering_env import Morphology  # noqa: E402
 from gathering_env.config import REWARD_SCOPES, REWARDS, WorldConfig  # noqa: E402
-from gathering_env.rl.sb3 import GatheringVecEnv  # noqa: E402
+from gathering_env.rl.sb3 import MAX_WHEEL_LEVELS, GatheringVecEnv  # noqa: E402
 
+DEFAULT_ENV_STEPS = 500_000
 EVAL_SEED = 10_000
 """First held-out evaluation seed (training episode seeds come from the --seed generator)."""
 
@@ -85,7 +94,7 @@ class EpisodeLog(BaseCallback):
             self.save()
 
     def save(self) -> None:
-        with open(self.path, "w", newline="") as f:
+        with writing(self.path), open(self.path, "w", newline="") as f:
             writer = csv.DictWriter(f, fieldnames=["env_steps", "minutes", "ft", "team_return"])
             writer.writeheader()
             writer.writerows(self.rows)
@@ -93,8 +102,10 @@ class EpisodeLog(BaseCallback):
 
 def save_model(model: PPO, path: Path, morphology: Morphology) -> None:
     """The policy and, next to it, its morphology (what ``gathering-compare --policy ppo:PATH`` reads)."""
-    model.save(path)
-    path.with_suffix(".morphology.json").write_text(json.dumps(morphology.to_dict(), indent=1))
+    with writing(path):
+        model.save(path)
+    with writing(path.with_suffix(".morphology.json")):
+        path.with_suffix(".morphology.json").write_text(json.dumps(morphology.to_dict(), indent=1))
 
 
 def plot_curve(rows: list[dict], path: Path, title: str) -> None:
@@ -120,7 +131,8 @@ def plot_curve(rows: list[dict], path: Path, title: str) -> None:
     ax.set_ylabel("per training episode")
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
@@ -137,13 +149,14 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                    help=f"bonus per attachment with --reward shaped (default {WorldConfig.attach_reward})")
     p.add_argument("--reward-scope", choices=REWARD_SCOPES, default="local",
                    help="credit: every robot the team reward, or local rewards (default local)")
-    p.add_argument("--wheel-levels", type=int, default=None, metavar="K",
+    p.add_argument("--wheel-levels", type=int_arg(2, MAX_WHEEL_LEVELS), default=None, metavar="K",
                    help="discrete actions: K evenly spaced commands per wheel (MultiDiscrete([K, K]); "
                         "default: continuous wheel commands with Gaussian noise)")
     p.add_argument("--morphology", type=Path, help="champion JSON whose morphology to use (default: Khepera III)")
-    p.add_argument("--env-steps", type=count, default=500_000, help="training budget in environment steps")
+    p.add_argument("--env-steps", type=count, default=None,
+                   help=f"training budget in environment steps (default {DEFAULT_ENV_STEPS:,})")
     p.add_argument("--timesteps", type=count, default=None,
-                   help="training budget in robot-steps (SB3 timesteps) instead of --env-steps")
+                   help="training budget in robot-steps (SB3 timesteps) instead of --env-steps (not both)")
     p.add_argument("--snapshots", type=count, nargs="*", default=[], metavar="ENV_STEPS",
                    help="also save the policy as model-ENV_STEPS.zip when training passes these budgets "
                         "(e.g. an evolution run's budget, to compare at equal environment steps)")
@@ -162,7 +175,13 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--seed", type=int_arg(0, 2**32 - 1), default=0)
     p.add_argument("--eval-episodes", type=count, default=5)
     p.add_argument("--out", type=Path, default=Path("runs/ppo"))
-    return p.parse_args(argv)
+    args = p.parse_args(argv)
+    if args.timesteps is not None and args.env_steps is not None:
+        raise UsageError(f"--timesteps {args.timesteps}: conflicts with --env-steps {args.env_steps} (both set the "
+                         "training budget); allowed: one of them")
+    if args.eval_steps is None:
+        args.eval_steps = args.steps
+    return args
 
 
 OUTPUTS = ("model.zip", "model.morphology.json", "progress.csv", "curve.csv", "curve.png", "evaluation.json")
@@ -175,6 +194,10 @@ def main(argv: list[str] | None = None) -> int:
     torch.set_num_threads(1)
     snapshots = [f"model-{n}{suffix}" for n in args.snapshots for suffix in (".zip", ".morphology.json")]
     check_output_dir(args.out, [*OUTPUTS, *snapshots])       # never overwrite anything but an earlier run's output
+    trained = sorted(p.name for p in args.out.glob("model*.zip")) if args.out.is_dir() else []
+    if trained:                                               # ... and never a trained model
+        raise UsageError(f"--out {args.out}: holds a trained model ({', '.join(trained)}), which is never "
+                         "overwritten; allowed: a new --out (or move the model away)")
 
     # 1. The morphology: Khepera III or an evolved champion's sensors.
     if args.morphology:
@@ -200,7 +223,7 @@ def main(argv: list[str] | None = None) -> int:
     model.set_logger(configure(str(args.out), ["stdout", "csv"]))
     log = EpisodeLog(args.out / "curve.csv", args.robots, args.max_minutes, args.snapshots, morphology)
     start = time.perf_counter()
-    budget = args.timesteps if args.timesteps is not None else args.env_steps * args.robots
+    budget = args.timesteps if args.timesteps is not None else (args.env_steps or DEFAULT_ENV_STEPS) * args.robots
     model.learn(total_timesteps=budget, callback=log, progress_bar=False)
     minutes = (time.perf_counter() - start) / 60
     log.save()
@@ -212,7 +235,7 @@ def main(argv: list[str] | None = None) -> int:
     plot_curve(log.rows, args.out / "curve.png", title)
 
     # 4. Evaluation on held-out seeds, through the same code path as gathering-compare.
-    eval_steps = args.eval_steps or args.steps
+    eval_steps = args.eval_steps
     seeds = list(range(EVAL_SEED, EVAL_SEED + args.eval_episodes))
     row, sampled = compare([ppo_policy(str(model_path)), ppo_policy(str(model_path), sample=True)],
                            {"environment": args.environment, "max_cycles": eval_steps, "num_robots": args.robots},
@@ -223,7 +246,8 @@ def main(argv: list[str] | None = None) -> int:
               "env_steps": env_steps, "robot_steps": model.num_timesteps, "train_minutes": round(minutes, 2),
               "eval_steps": eval_steps, "eval_seeds": seeds, **row,
               "sampled": {"ft_mean": sampled["ft_mean"], "ft_std": sampled["ft_std"]}}
-    (args.out / "evaluation.json").write_text(json.dumps(report, indent=1))
+    with writing(args.out / "evaluation.json"):
+        (args.out / "evaluation.json").write_text(json.dumps(report, indent=1))
     print(f"trained {env_steps} env steps ({model.num_timesteps} robot-steps) in {minutes:.1f} min; "
           f"ft over {len(seeds)} held-out episodes of {eval_steps} steps: {row['ft_mean']:.2f} +- {row['ft_std']:.2f} "
           f"(mean actions), {sampled['ft_mean']:.2f} +- {sampled['ft_std']:.2f} (sampled actions)")

@@ -1,6 +1,6 @@
 """Every world parameter of the collective gathering task in one validated dataclass.
 
-Units: lengths in world units (the arena is 40 x 40 by default, SPEC section 1),
+Units: lengths in world units (the arena is 40 x 40 by default, docs/model.md §1),
 time in seconds, angles in radians, masses in mass units, forces in force units
 (the pymunk solver's units; only their ratios matter).
 
@@ -44,7 +44,7 @@ BLOCK_TYPE_NAMES: tuple[str, str, str] = ("small", "medium", "large")
 class WorldConfig:
     """All parameters of the arena, robots, blocks, heuristics and scoring.
 
-    Defaults follow SPEC section 1-4 (the original implementation's numbers where the
+    Defaults follow docs/model.md §1-4 (the original implementation's numbers where the
     paper is silent). Every field can be overridden through ``parallel_env(**kwargs)``.
     """
 
@@ -60,7 +60,7 @@ class WorldConfig:
     """pymunk steps per environment step (each of dt / substeps); more = smaller contact
     overlaps at a proportional cost."""
     max_cycles: int = 10_000
-    """Steps per trial before truncation (SPEC: 10 000)."""
+    """Steps per trial before truncation (docs/model.md §1: 10 000)."""
 
     # --- team ----------------------------------------------------------------------
     num_robots: int = 20

@@ -29,6 +29,12 @@ Three world options (``gathering_env.rewards``; docs/rl/README.md); ``ft`` never
 | ``attach_reward`` | float >= 0, default 1.0 | shaped only: a robot earns it when it attaches to a block and gives it back when released (its block gathered) |
 | ``reward_scope`` | ``"team"`` (default), ``"local"`` | team: every robot receives the team reward. local: a block's distance term is split among the robots attached to it, a robot's attachment term goes to that robot, the rest equally to all robots; the robots' rewards sum to the team reward. |
 
+## Global state
+``state_space`` (a ``Box``) and ``state()``: one float32 vector of every robot's pose and
+attachment, every block's pose and gathered flag and the step fraction, for centralised
+critics (MAPPO, QMIX); layout in ``gathering_env.state`` and docs/environment.md. ``state()``
+before ``reset`` raises ``ValueError``.
+
 ## Episode end
 *Terminated* when every block lies wholly inside the zone; *truncated* after
 ``max_cycles`` steps (default 10 000). Agents are removed when the episode ends; calling
@@ -36,7 +42,9 @@ Three world options (``gathering_env.rewards``; docs/rl/README.md); ``ft`` never
 
 ## Infos
 ``gathered_value``, ``total_value``, ``blocks_gathered`` (count), ``blocks_gathered_by_type``
-(small, medium, large), ``steps``; at the episode's end also ``task_performance`` (ft).
+(small, medium, large), ``steps``, ``task_performance`` (ft of the episode so far, final at its
+end; present at every step so that wrappers which fix their info specs at reset, such as
+TorchRL's ``PettingZooWrapper``, see it).
 
 ## Arguments
 ``parallel_env(environment=2, num_robots=20, max_cycles=10_000, render_mode=None,
@@ -80,6 +88,7 @@ from .config import WorldConfig
 from .render import RenderOptions
 from .sensors import Morphology
 from .simulation import GatheringSimulation, check_wheels
+from .state import state_space, world_state
 from .world import GatheringWorld
 
 _ACTION_SPACE_BOUNDS = (-1.0, 1.0)
@@ -117,6 +126,7 @@ class GatheringEnv(ParallelEnv):
         self._action_space = spaces.Box(*_ACTION_SPACE_BOUNDS, shape=(2,), dtype=np.float32)
         self._action_spaces = {a: self._action_space for a in self.possible_agents}
         self._set_observation_spaces()
+        self.state_space = state_space(self.config)
         self._np_random: np.random.Generator | None = None
         self._renderer = None
 
@@ -132,6 +142,14 @@ class GatheringEnv(ParallelEnv):
     def action_space(self, agent: str) -> spaces.Box:
         """``Box(-1, 1, (2,), float32)``: left and right wheel drive."""
         return self._action_spaces[agent]
+
+    def state(self) -> np.ndarray:
+        """The global state (``state_space``; layout in ``gathering_env.state``) of the current step."""
+        if self._np_random is None:
+            raise ValueError("state() called before reset(); allowed: call reset() first, then state()")
+        sim, w = self.sim, self.sim.world
+        return world_state(self.config, w.robot_pos, w.robot_angle, w.robot_attached, w.block_pos,
+                           w.block_angle, sim.gathered, sim.steps)
 
     # ------------------------------------------------------------------ episode
     def reset(self, seed: int | None = None, options: dict | None = None):
@@ -245,9 +263,8 @@ class GatheringEnv(ParallelEnv):
             "blocks_gathered": int(sum(by_type)),
             "blocks_gathered_by_type": by_type,
             "steps": sim.steps,
+            "task_performance": sim.task_performance(),
         }
-        if sim.done:
-            info["task_performance"] = sim.task_performance()
         return info
 
     def _explain_action_keys(self, actions: dict[str, Any]) -> None:

@@ -8,7 +8,7 @@ counter-clockwise from the robot's heading, in [-pi, pi]. ``orientation`` turns 
 sensor's axis away from the rim's outward normal, in [-pi/2, pi/2]. ``range`` is in world
 units, ``fov`` is the full opening angle of the sensing cone.
 
-The bounds per type (``SENSOR_TYPES``) are SPEC section 3; the complexity measure is the
+The bounds per type (``SENSOR_TYPES``) are docs/model.md §3; the complexity measure is the
 paper's eq. 2 (higher = simpler).
 """
 
@@ -240,7 +240,7 @@ class Morphology(Sequence[SensorSpec]):
 
     @classmethod
     def khepera_iii(cls) -> Morphology:
-        """The default suite (SPEC section 3): bottom; IR at +-40 deg; ultrasonic at 0, +-90 deg.
+        """The default suite (docs/model.md §3): bottom; IR at +-40 deg; ultrasonic at 0, +-90 deg.
 
         IR: range 0.2 units, FOV pi/6 (the type minimum). Ultrasonic: range 4.0, FOV 1.22.
         """

@@ -7,7 +7,7 @@ trainers that drive the whole team at once:
     obs = sim.reset(seed=0, morphology=Morphology.khepera_iii())    # (N, S) float32
     obs, reward, terminated, truncated = sim.step(wheels)            # wheels: (N, 2)
 
-Step order (SPEC section 2): the controller's wheel commands (computed from the previous
+Step order (docs/model.md §2): the controller's wheel commands (computed from the previous
 observation) -> heuristics override them (collision avoidance, attached robots) -> drive
 -> physics step -> pickup -> scoring -> sensing of the new state.
 

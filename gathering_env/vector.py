@@ -24,6 +24,8 @@ Shapes: W worlds, N robots, S sensors, B blocks.
   terminated/truncated until ``reset_world``. ``active`` (W,) says which worlds still run.
 * ``reset_world(w, seed)`` -> obs ``(N, S)``: a new episode in one world (auto-reset).
 * ``robot_rewards()`` (W, N): each robot's reward of the last step (``reward_scope``).
+* ``observations()`` (W, N, S): the current readings (after ``reset``, ``step`` or ``reset_world``).
+* ``states()`` (W, D) float32: each world's global state (``gathering_env.state``).
 * ``task_performance()`` (W,), ``gathered_value`` (W,), ``steps`` (W,),
   ``blocks_gathered_by_type()`` (W, 3).
 
@@ -45,6 +47,7 @@ from .config import WorldConfig
 from .scoring import task_performance
 from .sensors import Morphology
 from .simulation import GatheringSimulation, NumpySimulation
+from .state import world_state
 
 Seed = int | np.random.Generator | None
 
@@ -196,6 +199,21 @@ class VectorSimulation:
                 return np.repeat(engine.reward[:, None], self.config.num_robots, axis=1)
             return engine.robot_reward.copy()
         return self._robot_reward.copy()
+
+    def observations(self) -> np.ndarray:
+        """(W, N, S) float32: every robot's current readings."""
+        self._require_started()
+        if self._engine is not None:
+            return self._engine.obs.copy()
+        return self._obs.copy()
+
+    def states(self) -> np.ndarray:
+        """(W, D) float32: each world's global state (layout in ``gathering_env.state``)."""
+        self._require_started()
+        gathered, steps = self.gathered(), self.steps
+        return np.stack([world_state(self.config, w.robot_pos, w.robot_angle, w.robot_attached, w.block_pos,
+                                     w.block_angle, gathered[i], int(steps[i]))
+                         for i, w in enumerate(self.worlds)])
 
     def task_performance(self) -> np.ndarray:
         """(W,) paper eq. 1 of each world's episode so far (final once it has ended)."""

@@ -97,7 +97,8 @@ def test_infos_rewards_and_truncation():
     e = parallel_env(environment=1, max_cycles=30)
     _, infos = e.reset(seed=1)
     assert set(infos["robot_0"]) == {"gathered_value", "total_value", "blocks_gathered",
-                                     "blocks_gathered_by_type", "steps"}
+                                     "blocks_gathered_by_type", "steps", "task_performance"}
+    assert infos["robot_0"]["task_performance"] == 0.0  # present at every step (TorchRL's wrapper needs it)
     assert infos["robot_0"]["total_value"] == 10 * 1 + 5 * 2
     steps = 0
     while e.agents:

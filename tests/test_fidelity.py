@@ -1,4 +1,4 @@
-"""Method fidelity (issue 10): shipped defaults vs SPEC, shared breeding, NEAT-MODS details,
+"""Method fidelity: shipped defaults vs docs/model.md, shared breeding, NEAT-MODS details,
 signed CPPN outputs, NEAT-M operators and speciation; each against hand values."""
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from gathering_env import SENSOR_TYPES
 
 CONFIGS = Path(__file__).resolve().parent.parent / "configs"
 
-# SPEC section 5, copied by hand: the original's probabilities of the one operator per offspring.
+# docs/model.md §5, copied by hand: the original's probabilities of the one operator per offspring.
 SPEC_OPERATORS = {
     CPPNGenome: {"crossover": 0.5, "weights": 0.494, "add_node": 0.0005, "add_link": 0.005, "remove_link": 0.0005},
     NEATMGenome: {"crossover": 0.32, "weights": 0.335, "add_node": 0.05, "add_link": 0.05, "remove_link": 0.005,
@@ -63,7 +63,9 @@ def test_shipped_cppn_outputs_signed_and_bottom_on_node0():
 def test_shipped_neat_m_sensor_defaults():
     gc = load(NEATMGenome).genome_config
     assert gc.sensor_remove_prob == 0.0                        # not in the original
-    assert NEATMGenome.parse_config  # noqa: B018 - the class parses its own section
+    # the original's sensor operators, read from the shipped section (not class defaults)
+    assert (gc.sensor_add_prob, gc.sensor_angle_mutate_prob, gc.sensor_reach_mutate_prob) == (0.07, 0.1, 0.07)
+    assert gc.sensor_types == ["infrared", "ultrasonic", "colour", "camera", "bottom"]
 
 
 # ---------------------------------------------------------------- shared breeding

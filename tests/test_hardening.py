@@ -1,4 +1,4 @@
-"""Issue 11, one test per class: data loss, hangs, tracebacks, silent acceptance, analysis
+"""One test per class of failure: data loss, hangs, tracebacks, silent acceptance, analysis
 input and resume. Every refusal is one line ``error: ...`` with exit status 2 and leaves
 the files it was given byte for byte as they were."""
 

@@ -16,8 +16,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-# what the wheel is built from (pyproject.toml names README.md and LICENSE)
-SOURCES = ("pyproject.toml", "README.md", "LICENSE", "gathering_env", "evolution", "configs")
+# what the wheel is built from (pyproject.toml names DESCRIPTION.md and LICENSE)
+SOURCES = ("pyproject.toml", "DESCRIPTION.md", "LICENSE", "gathering_env", "evolution", "configs")
 
 
 @pytest.mark.slow

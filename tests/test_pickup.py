@@ -1,4 +1,4 @@
-"""Pickup heuristic rules (SPEC section 2) on hand-placed scenes: box, reach, sticky side, full blocks."""
+"""Pickup heuristic rules (docs/model.md §2) on hand-placed scenes: box, reach, sticky side, full blocks."""
 
 from __future__ import annotations
 
@@ -38,7 +38,7 @@ def step(sim: GatheringSimulation) -> np.ndarray:
 
 def test_pickup_box_depth_and_facing():
     cfg = WorldConfig()
-    assert (cfg.pickup_box_width, cfg.pickup_box_depth) == (0.1, 0.2)   # SPEC: 0.1 wide x 0.2 deep
+    assert (cfg.pickup_box_width, cfg.pickup_box_depth) == (0.1, 0.2)   # docs/model.md §2: 0.1 wide x 0.2 deep
     near = world(0, 1)
     north(near, 0, gap=0.15)                  # face within the 0.2-deep box
     assert step(near)[0] == 0

@@ -48,7 +48,7 @@ def test_list_prints_every_preset_with_its_first_comment_sentence(capsys):
     assert listed["S1"] == "Experiment S1 of the paper: single objective (task performance), environment 1."
     assert listed["M3"].startswith("Experiment M3 of the paper: multi-objective")
     # a sentence that continues on the next comment line is joined
-    assert listed["neat_m.neat.cfg"].endswith("plus sensor genes), SPEC section 5.")
+    assert listed["neat_m.neat.cfg"].endswith("plus sensor genes), docs/model.md §5.")
     assert preset_description("quick") == listed["quick"]
 
 
@@ -129,3 +129,26 @@ def test_citation_names_the_paper():
                               "Cooperating Robots")
     assert paper["authors"][0]["family-names"] == "Nagar"
     assert "version" not in citation  # the version lives in gathering_env.__version__ only
+
+
+class _Parsed(Exception):
+    def __init__(self, parser):
+        self.parser = parser
+
+
+@pytest.mark.parametrize("main", ["evolution.cli:evolve_main", "evolution.cli:replay_main",
+                                  "evolution.cli:analyze_main", "evolution.compare:compare_main"])
+def test_every_command_line_option_has_help_text(main, monkeypatch):
+    import argparse
+    import importlib
+
+    module, name = main.split(":")
+
+    def capture(self, *args, **kwargs):
+        raise _Parsed(self)
+
+    monkeypatch.setattr(argparse.ArgumentParser, "parse_args", capture)
+    with pytest.raises(_Parsed) as caught:
+        getattr(importlib.import_module(module), name)([])
+    bare = [a.option_strings[0] for a in caught.value.parser._actions if a.option_strings and not a.help]
+    assert bare == []

@@ -75,7 +75,9 @@ def test_reevaluation_uses_heldout_seeds_and_is_cached(runs):
     champion = load_champion(so / "champion.json")
     held_out = so_scores["champion.json"]
     assert held_out["task"] != champion.objectives["task"]                # new worlds, another score
-    assert held_out["task"] == pytest.approx(np.mean(reference_ft(champion, held_out["seeds"])))
+    reference = reference_ft(champion, held_out["seeds"])
+    assert held_out["trial_ft"] == pytest.approx(reference)               # trial by trial, seed by seed
+    assert held_out["task"] == pytest.approx(np.mean(reference))
 
 
 def reference_ft(champion, seeds):
@@ -133,3 +135,84 @@ def test_bad_reevaluation_options(runs, tmp_path, capsys, args, needle):
     err = capsys.readouterr().err
     assert err.startswith("error: ") and needle in err and "allowed" in err and err.count("\n") == 1
     assert not (tmp_path / "r").exists()
+
+
+# ---------------------------------------------------------------------------- worlds actually stepped
+def spy_on_resets(monkeypatch) -> list[list[int]]:
+    """Record the seeds of every batch of worlds the evaluation resets."""
+    from gathering_env.vector import VectorSimulation
+
+    seen: list[list[int]] = []
+    original = VectorSimulation.reset
+
+    def reset(self, seeds, morphology=None):
+        seen.append([int(s) for s in seeds])
+        return original(self, seeds, morphology)
+
+    monkeypatch.setattr(VectorSimulation, "reset", reset)
+    return seen
+
+
+def fresh_copy(run, tmp_path):
+    copy = tmp_path / run.name
+    shutil.copytree(run, copy)
+    (copy / CACHE_FILE).unlink(missing_ok=True)
+    return copy
+
+
+def test_reevaluation_steps_the_heldout_worlds(runs, tmp_path, monkeypatch):
+    so = fresh_copy(runs[0], tmp_path)
+    experiment, _, _ = _run_setup(so)
+    seen = spy_on_resets(monkeypatch)
+    scores = reevaluate_run(so, 3, workers=1, backend="serial")
+    # By hand: SeedSequence([run seed, 2**32 - 1, t]), the tag no training generation reaches.
+    held = [int(np.random.SeedSequence([experiment.seed, 2**32 - 1, t]).generate_state(1)[0]) for t in range(3)]
+    assert not set(held) & training_seeds(experiment.seed, experiment.generations, experiment.trials)
+    assert seen == [held] * len(scores)                  # every genome stepped exactly the held-out worlds
+    assert all(entry["seeds"] == held for entry in scores.values())
+    champion = load_champion(so / "champion.json")
+    assert scores["champion.json"]["trial_ft"] == pytest.approx(reference_ft(champion, held))
+
+
+def test_reevaluation_cache_is_keyed_by_what_changes_the_score(runs, tmp_path, monkeypatch):
+    so = fresh_copy(runs[0], tmp_path)
+    seen = spy_on_resets(monkeypatch)
+    first = reevaluate_run(so, 3, workers=1, backend="serial")
+    assert len(seen) == 1
+    assert reevaluate_run(so, 3, workers=1, backend="serial") == first and len(seen) == 1   # cached
+    # Fewer trials: the two seeds are the first two of the three, but the score is another mean.
+    two = reevaluate_run(so, 2, workers=1, backend="serial")
+    assert len(seen) == 2 and seen[-1] == first["champion.json"]["seeds"][:2]
+    assert two["champion.json"]["trial_ft"] == first["champion.json"]["trial_ft"][:2]
+    # Another world (the run's experiment edited): evaluated again, in that world.
+    doc = json.loads((so / "experiment.json").read_text())
+    doc["environment"]["max_cycles"] = 40
+    (so / "experiment.json").write_text(json.dumps(doc))
+    shorter = reevaluate_run(so, 3, workers=1, backend="serial")
+    assert len(seen) == 3 and seen[-1] == first["champion.json"]["seeds"]
+    champion = load_champion(so / "champion.json")
+    champion.environment["max_cycles"] = 40
+    assert shorter["champion.json"]["trial_ft"] == pytest.approx(reference_ft(champion, seen[-1]))
+
+
+def test_cache_key_covers_genome_method_world_substrate_and_seeds():
+    from types import SimpleNamespace
+
+    from evolution.analysis.reevaluate import _entry_key
+
+    base = dict(method="hyperneat-m", environment={"environment": 1, "max_cycles": 80}, substrate={},
+                complexity="paper")
+    genome = {"key": 1, "nodes": [[0, 0.5]]}
+    key = _entry_key(genome, SimpleNamespace(**base), [1, 2, 3])
+    assert _entry_key(dict(genome), SimpleNamespace(**base), [1, 2, 3]) == key            # same inputs
+    variants = [
+        (dict(genome, nodes=[[0, 0.6]]), base, [1, 2, 3]),                                  # genome
+        (genome, dict(base, method="neat-m"), [1, 2, 3]),                                    # method
+        (genome, dict(base, environment={"environment": 1, "max_cycles": 81}), [1, 2, 3]),  # world
+        (genome, dict(base, substrate={"hidden_nodes": 2}), [1, 2, 3]),                     # substrate
+        (genome, dict(base, complexity="original"), [1, 2, 3]),                              # eq. 2 variant
+        (genome, base, [1, 2]),                                                              # trials
+        (genome, base, [1, 2, 4]),                                                           # seeds
+    ]
+    keys = {_entry_key(g, SimpleNamespace(**e), seeds) for g, e, seeds in variants}
+    assert len(keys) == len(variants) and key not in keys

@@ -285,7 +285,7 @@ def test_save_video_mp4(tmp_path):
     assert len(back) == 4 and back[0].shape[:2] == (162, 162)
 
 
-# ---------------------------------------------------------------------- legible replays (issue 13)
+# ---------------------------------------------------------------------- legible replays
 def empty_arena_colour(renderer: Renderer, sim: GatheringSimulation, frame: np.ndarray) -> np.ndarray:
     """(H, W, 3) colour every arena pixel would have with nothing on it (FLOOR or ZONE), by hand."""
     h, w = frame.shape[:2]
@@ -560,7 +560,8 @@ BAD_OPTIONS = [
     (dict(view="side"), r"view: 'side' is not a view; allowed: 'full', 'zone' or 'follow:K' with K in 0\.\.19"),
     (dict(view="follow:x"), r"view: .*allowed: 'full', 'zone' or 'follow:K'"),
     (dict(view="follow:20"), r"view: robot 20 does not exist.*allowed:"),
-    (dict(size_px=10), r"size_px: 10 .*allowed: an integer >= 64"),
+    (dict(size_px=10), r"size_px: 10 .*allowed: an integer in 64..4096"),
+    (dict(size_px=100_000), r"size_px: 100000 .*allowed: an integer in 64..4096"),
     (dict(trail=-1), r"trail: -1 .*allowed: an integer >= 0"),
     (dict(panel="yes"), r"panel: 'yes' .*allowed: True or False"),
     (dict(min_robot_px=0), r"min_robot_px: 0 .*allowed: an integer >= 1"),

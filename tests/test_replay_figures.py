@@ -66,7 +66,8 @@ def test_film_strip_panels_full_view(champion, tmp_path):
     (["--cones", "9"], "error: --cones: robot index 9 does not exist (8 robots); allowed:"),
     (["--view", "top"], "error: --view: 'top' is not a view; allowed: 'full', 'zone' or 'follow:K' with K in 0..7"),
     (["--view", "follow:8"], "error: --view: robot 8 does not exist"),
-    (["--size", "20"], "error: --size: 20 is not an integer >= 64; allowed: an integer >= 64"),
+    (["--size", "20"], "error: --size: 20 is not an integer in 64..4096; allowed: an integer in 64..4096 (pixels)"),
+    (["--size", "100000"], "error: --size: 100000 is not an integer in 64..4096"),
     (["--trail", "-2"], "error: --trail: -2 is not an integer >= 0; allowed:"),
     (["--min-robot-px", "0"], "error: --min-robot-px: 0 is not an integer >= 1; allowed:"),
     (["--strip", "0,50", "--png", "s.png"], "error: --strip: step 50 is outside the episode; allowed: "
@@ -82,3 +83,16 @@ def test_bad_replay_options_exit_2_with_one_line(champion, tmp_path, capsys, mon
     err = capsys.readouterr().err
     assert err.startswith(message) and err.count("\n") == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["champion.json"]  # nothing written
+
+
+def test_replay_says_its_episode_is_unseen_and_quotes_the_training_ft(champion, tmp_path, capsys):
+    doc = json.loads(champion.read_text())
+    doc["objectives"]["task"] = 12.5  # trained score; the replayed episode scores 0 here
+    champion.write_text(json.dumps(doc))
+    assert replay_main([str(champion), "--seed", "4", "--out", str(tmp_path / "t.gif")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert "ft = 0.00" in lines[0]
+    assert lines[1] == ("an unseen episode (seed 4): the training ft 12.50 is the mean over the run's own trial "
+                        "episodes; one new episode can score far from it")
+    assert replay_main([str(champion), "--steps", "20", "--out", str(tmp_path / "u.gif")]) == 0
+    assert "an unseen episode (seed 0) in a changed world (max_cycles): " in capsys.readouterr().out

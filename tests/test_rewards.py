@@ -217,3 +217,44 @@ def test_pettingzoo_api_test_with_local_shaped_rewards():
 
     parallel_api_test(parallel_env(environment=1, num_robots=4, max_cycles=60, reward="shaped",
                                    reward_scope="local"), num_cycles=80)
+
+
+def test_local_credit_of_blocks_nobody_holds_is_shared_by_everyone():
+    """RewardShaper by hand, two worlds of four robots and three blocks. World 0: robots 0 and
+    1 hold block 0, robot 3 holds block 2 and lets go, robot 2 attaches to block 1, which nobody
+    held at the start of the step. Each block moves 0.5, 0.3 or
+    0.1 towards the zone. The documented split: a held block's potential change to its holders
+    at the start of the step (equally), a free block's change to all four robots equally, the
+    attachment term to the robot that attached or let go, the task reward to all equally.
+    World 1: robot 1 holds block 2 throughout, blocks 0 and 1 are free."""
+    from gathering_env.rewards import RewardShaper
+
+    cfg = WorldConfig.from_kwargs(environment=None, block_counts=(3, 0, 0), num_robots=4, reward="shaped",
+                                  reward_scope="local", attach_reward=0.5)
+    half, value = np.full(3, 0.25), np.ones(3)
+    x0, y0, x1, y1 = cfg.zone_rect
+    start = np.array([[x0 + 2.0, y1 + 3.0], [x0 + 4.0, y1 + 2.0], [x0 + 6.0, y1 + 1.0]])
+    step = np.array([0.5, 0.3, 0.1])
+    end = start - np.stack([np.zeros(3), step], axis=1)              # straight south, towards the zone
+    before = np.array([[0, 0, -1, 2], [-1, 2, -1, -1]])
+    after = np.array([[0, 0, 1, -1], [-1, 2, -1, -1]])
+    shaper = RewardShaper(cfg, half, value)
+    shaper.before(np.stack([start, start]), before)
+    task = np.array([4.0, 0.0])
+    team, robot = shaper.after(task, np.stack([end, end]), after)
+
+    # Phi's distance term of a block above the zone: -100 * value * (y - (y1 - half)) / (V * diagonal)
+    scale = 100.0 / (cfg.total_value * math.hypot(cfg.arena_width, cfg.arena_height))
+    change = scale * step                                             # each block's gain in potential
+    expected = np.full((2, 4), 0.0)
+    expected[:, :] += task[:, None] / 4
+    expected[0, [0, 1]] += change[0] / 2                              # block 0: its two holders
+    expected[0, 3] += change[2]                                       # block 2: robot 3 held it at the start
+    expected[0, :] += change[1] / 4                                   # block 1: nobody held it -> everyone
+    expected[0, 2] += 0.5                                             # robot 2 attached
+    expected[0, 3] -= 0.5                                             # robot 3 let go
+    expected[1, 1] += change[2]                                       # world 1: robot 1 holds block 2,
+    expected[1, :] += (change[0] + change[1]) / 4                     # blocks 0 and 1 are free
+    np.testing.assert_allclose(robot, expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(team, task + change.sum(), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(robot.sum(axis=1), team, rtol=0, atol=1e-12)

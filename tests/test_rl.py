@@ -47,7 +47,7 @@ def test_compare_two_policies_writes_table_and_figure(tmp_path, capsys):
     assert compare_main(["--policy", "random", "--policy", "heuristic", "--environment", "1", "--steps", "60",
                          "--robots", "5", "--episodes", "2", "--out", str(tmp_path)]) == 0
     header = (tmp_path / "compare.csv").read_text().splitlines()[0].split(",")
-    assert header == ["policy", "sensors", "episodes", "ft_mean", "ft_std", "small", "medium", "large",
+    assert header == ["policy", "sensors", "episodes", "ft_mean", "ft_std", "ft_se", "small", "medium", "large",
                       "finished", "steps_to_finish"]
     assert (tmp_path / "compare.png").read_bytes()[:4] == b"\x89PNG"
     table = (tmp_path / "compare.md").read_text()
@@ -268,13 +268,18 @@ def test_rl_ppo_example_trains_saves_snapshots_and_evaluates(tmp_path):
     (["--gamma", "nan"], "--gamma: nan is out of range; allowed: a number > 0.0 and <= 1.0"),
     (["--learning-rate", "0"], "--learning-rate: 0 is out of range"),
     (["--robots", "100000"], "num_robots=100000 out of range"),
-    (["--wheel-levels", "1"], "wheel_levels=1; allowed: None"),
+    (["--wheel-levels", "1"], "--wheel-levels: 1 is out of range; allowed: 2..101"),
+    (["--timesteps", "30"], "--timesteps 30: conflicts with --env-steps 10"),   # was: --env-steps ignored
+    (["--out", "{tmp}/trained"], "holds a trained model (model.zip), which is never overwritten"),
 ])
 def test_rl_ppo_example_refuses_bad_input_in_one_line(tmp_path, capsys, argv, needle):
     """A wrong path, a folder with someone's files, a nonsense number: one line, exit 2, and
     nothing written (no output folder made, the user's file untouched)."""
     (tmp_path / "full").mkdir()
     (tmp_path / "full" / "notes.txt").write_text("keep")
+    if "{tmp}/trained" in argv:  # an earlier run's output, with its trained model
+        (tmp_path / "trained").mkdir()
+        (tmp_path / "trained" / "model.zip").write_bytes(b"PK trained weights")
     argv = [a.format(tmp=tmp_path) for a in argv]
     if "--out" not in argv:
         argv += ["--out", str(tmp_path / "new")]
@@ -285,5 +290,55 @@ def test_rl_ppo_example_refuses_bad_input_in_one_line(tmp_path, capsys, argv, ne
     assert code == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("error: ") and len(err.splitlines()) == 1 and needle in err, err
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["full"]
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name != "trained") == ["full"]
     assert (tmp_path / "full" / "notes.txt").read_text() == "keep"
+    if (tmp_path / "trained").exists():
+        assert (tmp_path / "trained" / "model.zip").read_bytes() == b"PK trained weights"
+
+
+def test_vecenv_worlds_ending_at_different_steps():
+    """World 1 gathers its block at step 121 and world 0 runs to the step limit (150): each end
+    reports done for its own N sub-environments only, with its own terminal observation, ft and
+    return, and that world's return starts again from 0 (the other's does not)."""
+    from evolution.policies.scripted import WanderTeam
+    from gathering_env.rl.sb3 import SEED_LIMIT, GatheringVecEnv
+    from gathering_env.vector import VectorSimulation
+
+    options = dict(environment=None, arena_width=6.0, arena_height=6.0, zone_width=6.0, zone_depth=2.0,
+                   block_counts=(1, 0, 0), num_robots=8, max_cycles=150, reward="shaped")
+    n = 8
+    venv = GatheringVecEnv(2, seed=16, **options)
+    draws = iter(int(s) for s in np.random.default_rng(16).integers(0, SEED_LIMIT, 8))
+    reference = VectorSimulation(2, **options)
+    ref_obs = reference.reset([next(draws), next(draws)])
+    obs = venv.reset()
+    team = WanderTeam(venv.sim.morphology, seed=0)
+    returns = np.zeros(2)
+    ends = []
+    for t in range(280):
+        actions = team.act(obs).astype(np.float32)
+        obs, rewards, dones, infos = venv.step(actions)
+        ref_obs, ref_team, terminated, truncated = reference.step(actions.reshape(2, n, 2).astype(np.float64))
+        returns += ref_team
+        ended = terminated | truncated
+        np.testing.assert_array_equal(dones, np.repeat(ended, n))        # sub-env k is world k // n
+        ft = reference.task_performance()
+        if ended.any() and not ends:
+            assert np.all(returns[~ended] != 0.0)   # the running world has a return a wrong reset would lose
+        for w in range(2):
+            block = slice(w * n, (w + 1) * n)
+            if not ended[w]:
+                assert infos[block] == [{}] * n
+                np.testing.assert_array_equal(obs[block], ref_obs[w])
+                continue
+            ends.append((t, w, bool(terminated[w])))
+            for i, info in enumerate(infos[block]):
+                np.testing.assert_array_equal(info["terminal_observation"], ref_obs[w, i])
+                assert info["task_performance"] == ft[w]
+                assert info["team_return"] == pytest.approx(returns[w])
+                assert info["TimeLimit.truncated"] is bool(truncated[w] and not terminated[w])
+            np.testing.assert_array_equal(obs[block], reference.reset_world(w, next(draws)))  # next seed
+            returns[w] = 0.0
+    # (the seed was picked for this pattern; if a physics change alters it, pick another seed
+    # whose worlds end at different steps, one by gathering and one by the step limit)
+    assert ends == [(120, 1, True), (149, 0, False), (270, 1, False)]

@@ -13,9 +13,7 @@ import pytest
 import small_runs
 from small_runs import evolve, experiment_file
 
-from evolution.analysis.reevaluate import _run_setup
 from evolution.run import trainer as trainer_module
-from evolution.run.champion import genome_from_dict, load_champion
 from evolution.run.evaluate import Evaluation, evaluate, sensor_statistics, trial_seed
 from evolution.run.experiment import load_experiment
 from evolution.run.stats import read_stats, without_timing
@@ -39,18 +37,34 @@ def team_ft(controller, morphology, env_config, seed):
             return env.team_info()["task_performance"]
 
 
-def test_fitness_is_the_mean_ft_over_distinct_trial_seeds(mo_run):
-    _, run = mo_run
-    experiment, config, substrate = _run_setup(run)
-    champion = load_champion(run / "champion.json")
-    genome = genome_from_dict(champion.genome, config)
-    seeds = [trial_seed(experiment.seed, 1, t) for t in range(4)]
-    assert len(set(seeds)) == 4
-    ev = evaluate(genome, config, experiment.environment, trials=4, seed=experiment.seed, generation=1,
-                  method=experiment.method, substrate=substrate)
-    reference = [team_ft(champion.controller, champion.morphology, experiment.environment, s) for s in seeds]
-    assert ev.trial_ft == pytest.approx(reference)
-    assert ev.task == pytest.approx(sum(reference) / 4)
+HAND_WORLD = dict(environment=1, arena_width=6.0, arena_height=6.0, zone_width=6.0, zone_depth=2.0,
+                  block_counts=[12, 0, 0], max_cycles=150, num_robots=10)
+
+
+def hand_cppn():
+    """(config, genome): a hand-built CPPN, both wheels forward, the right one faster (x2 link)."""
+    from test_substrate import BIAS, X2, cppn, cppn_config
+
+    config = cppn_config()
+    return config, cppn(config, {(X2, BIAS): 1.0}, biases={BIAS: 0.3})
+
+
+def test_fitness_is_the_mean_ft_over_distinct_trial_seeds():
+    """On a hand-built CPPN whose trial scores differ, the fitness is their mean, each trial
+    on its own seed."""
+    from evolution.encodings.substrate import Substrate, decode
+
+    config, genome = hand_cppn()
+    world = HAND_WORLD
+    seeds = [trial_seed(3, 3, t) for t in range(5)]
+    assert len(set(seeds)) == 5
+    controller, morphology = decode(genome, config, Substrate())
+    reference = [team_ft(controller, morphology, world, s) for s in seeds]
+    assert len(set(reference)) >= 3                   # the trials' scores differ (else mean = max = any)
+    ev = evaluate(genome, config, world, trials=5, seed=3, generation=3, method="hyperneat-m")
+    assert ev.trial_ft == pytest.approx(reference)    # trial t ran on seed t, in order
+    assert ev.task == pytest.approx(sum(reference) / 5)
+    assert all(ev.task != pytest.approx(ft) for ft in reference)   # no single trial, nor the max, is the mean
 
 
 def test_front_files_are_non_dominated(mo_run):
@@ -76,6 +90,25 @@ def test_neat_m_mo_run_resumes_to_the_uninterrupted_result(mo_run, tmp_path):
     assert without_timing(read_stats(copy / "stats.jsonl")) == without_timing(read_stats(run / "stats.jsonl"))
     assert front_files(copy) == front_files(run)
     assert json.loads((copy / "champion.json").read_text()) == json.loads((run / "champion.json").read_text())
+
+
+def test_a_run_directory_moves_between_machines(mo_run, tmp_path):
+    from evolution.cli import evolve_main
+
+    exp, run = mo_run
+    recorded = json.loads((run / "experiment.json").read_text())
+    assert recorded["neat_config"] == "neat_m.neat.cfg"          # a preset's name, no folder
+    assert len(recorded["neat_config_sha256"]) == 64
+    for path in run.rglob("*"):                                   # no text file names a folder of this machine
+        if path.suffix in {".json", ".jsonl", ".csv", ".cfg"}:
+            assert str(run.parent) not in path.read_text(), path
+    here, moved = tmp_path / "here", tmp_path / "elsewhere" / "deeper" / "run"
+    shutil.copytree(run, here)
+    shutil.copytree(run, moved)
+    for target in (here, moved):  # the run's own experiment, one generation more
+        assert evolve_main(["--resume", str(target), "--generations", "3", "--workers", "1", "--no-progress"]) == 0
+    assert without_timing(read_stats(moved / "stats.jsonl")) == without_timing(read_stats(here / "stats.jsonl"))
+    assert len(read_stats(moved / "stats.jsonl")) == 3
 
 
 class ScriptedEvaluator:
@@ -112,3 +145,39 @@ def test_so_convergence_stop_fires_exactly_at_the_threshold(tmp_path, monkeypatc
     mo.write_text(mo.read_text().replace("num_robots = 10", f"num_robots = 10\ntime_bonus = {bonus}"))
     result = trainer_module.Trainer(load_experiment(mo), tmp_path / "mo-run", workers=1, progress=False).run()
     assert not result.converged and result.generations == 4
+
+
+def test_per_process_worlds_are_keyed_by_the_whole_world_configuration():
+    """The evaluation's cached batch of worlds is rebuilt whenever any world option or the
+    number of trials changes: every result equals one from a fresh process."""
+    from evolution.run import evaluate as evaluation
+    from gathering_env.config import WorldConfig
+
+    base = dict(environment=1, arena_width=6.0, arena_height=6.0, zone_width=6.0, zone_depth=2.0,
+                block_counts=[8, 0, 0], max_cycles=60, num_robots=10)
+    variants = [dict(base, max_cycles=50), dict(base, block_counts=[7, 1, 0]), dict(base, zone_depth=1.5),
+                dict(base, arena_width=7.0), dict(base, collision_avoidance=True), dict(base, ir_response="gamma"),
+                dict(base, kernel="numpy"), dict(base, reward="shaped"), dict(base, physics_substeps=2)]
+    for variant in variants:
+        evaluation._worlds_for(base, 2)                                  # a warm cache of another world
+        sims = evaluation._worlds_for(variant, 2)
+        assert sims.config == WorldConfig.from_kwargs(**variant), variant
+        assert sims.config != WorldConfig.from_kwargs(**base)
+    assert evaluation._worlds_for(base, 3).num_worlds == 3 and evaluation._worlds_for(base, 2).num_worlds == 2
+    # and the scores: a short world evaluated after a long one scores as in a fresh process
+    config, genome = hand_cppn()
+    evaluate(genome, config, HAND_WORLD, trials=5, seed=3, generation=1)
+    warm = evaluate(genome, config, dict(HAND_WORLD, max_cycles=60), trials=5, seed=3, generation=1)
+    evaluation._SIM_CACHE.clear()
+    cold = evaluate(genome, config, dict(HAND_WORLD, max_cycles=60), trials=5, seed=3, generation=1)
+    assert warm.trial_ft == cold.trial_ft and warm.steps == cold.steps == 5 * 60
+
+
+def test_a_failed_evaluation_has_the_worst_objectives_and_keeps_its_error():
+    ev = Evaluation.failure("worker died")
+    assert ev.objectives(("task", "morphology", "controller")) == (0.0, 0.0, 0.0)   # every minimum
+    assert ev.failed and ev.error == "worker died" and ev.trial_ft == [] and ev.steps == 0
+    np.testing.assert_equal(ev.sensors, sensor_statistics(Morphology()))            # NaN means: no sensor
+    assert ev.sensors["num_sensors"] == 0.0
+    np.testing.assert_equal(Evaluation(**ev.to_dict()).to_dict(), ev.to_dict())
+    assert not Evaluation(task=1.0, morphology=2.0, controller=3.0).failed

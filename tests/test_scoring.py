@@ -27,8 +27,12 @@ def test_task_performance_by_hand():
     assert task_performance(20, 20, 2500, 10_000) == pytest.approx(100 + 20 * 0.75)
     assert task_performance(20, 20, 10_000, 10_000) == pytest.approx(100.0)
     assert task_performance(20, 20, 5000, 10_000, time_bonus=10) == pytest.approx(105.0)
+    assert task_performance(1, 1, 50, 100) == pytest.approx(110.0)                # one small block, in half the steps
+    assert task_performance(0.25, 0.5, 100, 100) == pytest.approx(50.0)           # any positive total value
     with pytest.raises(ValueError):
         task_performance(1, 0, 1, 1)
+    with pytest.raises(ValueError):
+        task_performance(0, -1, 1, 1)
 
 
 def make_env(**kw):
@@ -85,3 +89,29 @@ def test_rewards_sum_to_the_value_part_of_ft():
         total += r
     info = e.team_info()
     assert total == pytest.approx(100 * info["gathered_value"] / info["total_value"])
+
+
+def test_gathered_mask_against_the_rotated_corners():
+    """Brute force: a block is gathered when all four corners of the rotated square lie in the
+    zone (edges included); plus blocks touching each edge exactly, straight and turned 90 deg."""
+    rng = np.random.default_rng(5)
+    m = 4000
+    half = rng.choice([0.2, 0.3, 0.4], m)
+    angle = rng.uniform(-np.pi, np.pi, m)
+    pos = np.stack([rng.uniform(9.0, 31.0, m), rng.uniform(-1.0, 9.0, m)], axis=1)
+    corners = np.array([[1, 1], [1, -1], [-1, 1], [-1, -1]], dtype=float)
+    c, s = np.cos(angle), np.sin(angle)
+    cx = pos[:, None, 0] + half[:, None] * (corners[None, :, 0] * c[:, None] - corners[None, :, 1] * s[:, None])
+    cy = pos[:, None, 1] + half[:, None] * (corners[None, :, 0] * s[:, None] + corners[None, :, 1] * c[:, None])
+    x0, y0, x1, y1 = ZONE
+    want = ((cx >= x0) & (cx <= x1) & (cy >= y0) & (cy <= y1)).all(axis=1)
+    got = gathered_mask(pos, angle, half, ZONE)
+    assert 500 < want.sum() < m - 500                  # both outcomes well represented
+    np.testing.assert_array_equal(got, want)
+    # exactly touching each edge from inside counts; a hair outside does not
+    h = 0.25
+    touching = np.array([[x0 + h, 4.0], [x1 - h, 4.0], [20.0, y0 + h], [20.0, y1 - h]])
+    for turn in (0.0, np.pi / 2):
+        assert gathered_mask(touching, np.full(4, turn), np.full(4, h), ZONE).all(), turn
+        out = touching + np.array([[-1e-9, 0], [1e-9, 0], [0, -1e-9], [0, 1e-9]])
+        assert not gathered_mask(out, np.full(4, turn), np.full(4, h), ZONE).any(), turn

@@ -1,4 +1,4 @@
-"""Hand-placed sensor scenes: readings computed by hand from SPEC section 3."""
+"""Hand-placed sensor scenes: readings computed by hand from docs/model.md §3."""
 
 from __future__ import annotations
 
@@ -96,13 +96,17 @@ def test_rotated_block_nearest_point():
 
 
 def test_a_robot_never_sees_itself():
-    # Mounted at the front, turned to look north with a 180 deg cone: the robot's own centre lies
-    # on the cone's edge at distance 0.15 (surface 0), so only the self-exclusion keeps it at 0.
+    # Facing -x, mounted at the front (19.85, 20), turned +90 deg to look south with a 180 deg cone:
+    # the robot's own disc touches the mount (surface 0) and its centre lies on the cone's edge,
+    # inside it in floating point at this heading, so only the self-exclusion keeps the reading 0.
     wide = SensorSpec("ultrasonic", 0.0, math.pi / 2, 0.5, math.pi)
-    got = read(bank([wide]), [(20, 20, 0.0), FAR, (35, 5, 0.0)], [(5, 35, 0.0)])
-    assert got[0, 0] == 0.0
-    # Another robot centred 0.2 north of the mount is seen: surface at d = 0.05 -> (1 - 0.1) / 0.95.
-    got = read(bank([wide]), [(20, 20, 0.0), (20.15, 20.2, 0.0), (35, 5, 0.0)], [(5, 35, 0.0)])
+    robots = [(20, 20, -math.pi), FAR, (35, 5, 0.0)]
+    unguarded = bank([wide], kernel="numpy")
+    unguarded._reach_sq[np.arange(3), np.arange(3)] = unguarded._reach_sq[0, 1]   # self not excluded
+    assert read(unguarded, robots, [(5, 35, 0.0)])[0, 0] == 1.0                     # it would see itself
+    assert read(bank([wide]), robots, [(5, 35, 0.0)])[0, 0] == 0.0
+    # Another robot centred 0.2 south of the mount is seen: surface at d = 0.05 -> (1 - 0.1) / 0.95.
+    got = read(bank([wide]), [(20, 20, -math.pi), (19.85, 19.8, 0.0), (35, 5, 0.0)], [(5, 35, 0.0)])
     assert got[0, 0] == pytest.approx(0.9 / 0.95)
 
 

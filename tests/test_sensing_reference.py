@@ -1,8 +1,8 @@
 
 """The vectorised sensing kernel agrees with a plain per-robot, per-sensor, per-object loop.
 
-The reference below is written independently of ``gathering_env.reference.sensing`` from SPEC
-section 3: nearest points by brute-force sampling-free geometry, cones by angles (atan2),
+The reference below is written independently of ``gathering_env.reference.sensing`` from
+docs/model.md §3: nearest points by brute-force sampling-free geometry, cones by angles (atan2),
 walls by scanning the cone's edge and normal directions.
 """
 

@@ -21,11 +21,16 @@ X1, Y1, X2, Y2 = -1, -2, -3, -4            # neat-python input keys
 WEIGHT, FOV, ORIENT, RANGE, TYPE, BIAS = range(6)
 
 
-@pytest.fixture(scope="module")
-def config():
+def cppn_config():
+    """The shipped HyperNEAT-M neat config, ready to build genomes by hand."""
     cfg = neat.Config(CPPNGenome, NEATReproduction, GatheringSpeciesSet, neat.DefaultStagnation, str(CFG))
     cfg.genome_config.innovation_tracker = InnovationTracker()
     return cfg
+
+
+@pytest.fixture(scope="module")
+def config():
+    return cppn_config()
 
 
 def cppn(config, links: dict[tuple[int, int], float], biases: dict[int, float] | None = None):
@@ -92,6 +97,21 @@ def test_strongest_link_chooses_the_sensor(config):
     genome = cppn(config, {(X2, WEIGHT): 0.4, (X2, TYPE): 0.7}, biases={WEIGHT: 0.5})
     _, morph = decode(genome, config, Substrate(bottom_on_node0=False))
     assert {s.type for s in morph} == {"camera"}
+
+
+@pytest.mark.parametrize("slope, kind, fov_sign", [(-1.2, "ultrasonic", -1), (1.2, "camera", 1)])
+def test_sensor_comes_from_the_highest_signed_weight_not_the_largest_magnitude(config, slope, kind, fov_sign):
+    # weight = -0.3 + slope * x2: with slope -1.2 the left link (x2 = -0.5) has +0.3 and the right
+    # (x2 = +0.5) -0.9; both exist (|w| > 0.2) and the signed maximum is the left one, though the
+    # right one is larger in magnitude. slope +1.2 mirrors it. type = 0.7 * x2: -0.35 on the left
+    # (ultrasonic band), +0.35 on the right (camera); fov = 0.8 * x2 likewise from the same link.
+    genome = cppn(config, {(X2, WEIGHT): slope, (X2, TYPE): 0.7, (X2, FOV): 0.8}, biases={WEIGHT: -0.3})
+    controller, morph = decode(genome, config, Substrate(bottom_on_node0=False))
+    assert len(morph) == 10 and controller.num_links == 20           # every input links to both outputs
+    spec = SENSOR_TYPES[kind]
+    for s in morph:
+        assert s.type == kind
+        assert s.fov == pytest.approx(spec.fov_min + (1 + fov_sign * 0.4) / 2 * (spec.fov_max - spec.fov_min))
 
 
 def test_bottom_sensor_on_node_zero(config):

@@ -35,7 +35,7 @@ from scipy import stats as sps
 
 from evolution.reproduction.pareto import non_dominated_fronts
 from evolution.run.champion import ChampionError, champion_objectives, read_json
-from evolution.run.stats import read_stats
+from evolution.run.stats import check_generations, read_stats
 
 SELECTION_POINTS = ("max", "mean", "knee", "epsilon")
 EPSILON = 0.10
@@ -87,6 +87,7 @@ def load_run(path: Path) -> Run:
             value = record.get(key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise ValueError(f"{path / 'stats.jsonl'}: record {i} has {key} = {value!r}; allowed: a finite number")
+    check_generations(path / "stats.jsonl", records)
     champion = None
     champ_file = path / "champion.json"
     if champ_file.exists():
@@ -177,6 +178,30 @@ class Comparison:
     shapiro_mo_p: float
     n_so: int
     n_mo: int
+
+
+    @property
+    def untested(self) -> str | None:
+        """Why there is no t-test (None when there is one): too few runs, or no variation."""
+        if self.n_so < 2 or self.n_mo < 2:
+            return f"too few runs for a test (SO {self.n_so}, MO {self.n_mo}; a t-test needs 2 of each)"
+        if math.isnan(self.p_value):
+            return (f"no variation (every SO run {self.so_mean:.2f}, every MO run {self.mo_mean:.2f}): "
+                    "no test")
+        return None
+
+
+def nothing_to_compare(analysis: Analysis) -> str | None:
+    """One line when Table 4 has no cell (no environment with both SO and MO runs), else None."""
+    if analysis.comparisons:
+        return None
+
+    def envs(multi: bool) -> str:
+        found = sorted({r.environment for r in analysis.runs if r.multi_objective == multi})
+        return "environment " + ", ".join(map(str, found)) if found else "none"
+
+    return (f"nothing to compare: Table 4 needs SO and MO runs of the same environment "
+            f"(SO runs: {envs(False)}; MO runs: {envs(True)})")
 
 
 def _shapiro(sample: np.ndarray) -> float:

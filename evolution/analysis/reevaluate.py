@@ -17,13 +17,18 @@ against every training seed of the run; on a (32-bit) collision the next tag dow
 Cache: ``RUN_DIR/reevaluation.json`` (written atomically; an existing file of another
 format is never overwritten). Each entry is keyed by a hash of the genome's genes, the
 method, environment and substrate, and the list of held-out seeds (so the run seed and K),
-and holds the objectives and per-trial ft.
+and holds the objectives and per-trial ft. The file carries a version and a SHA-256 checksum
+of its entries, and every entry is checked (finite numbers, one ft per seed) before it is
+used, as checkpoints are: a damaged, edited or other-version cache is set aside
+(``reevaluation.json.set-aside-N``) with a warning and its genomes are evaluated again.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import math
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -37,7 +42,8 @@ REEVALUATE_TRIALS = 20
 HELDOUT_GENERATION = 2**32 - 1
 CACHE_FILE = "reevaluation.json"
 CACHE_FORMAT = "gathering-evolution/reevaluation"
-CACHE_VERSION = 1
+CACHE_VERSION = 2
+"""Version 2 added the checksum (a version-1 cache is set aside and recomputed)."""
 
 
 def training_seeds(run_seed: int, generations: int, trials: int) -> set[int]:
@@ -77,18 +83,79 @@ def _run_setup(run_dir: Path) -> tuple[Any, Any, Any]:
     return experiment, config, substrate_for(experiment)
 
 
+def _checksum(entries: dict[str, Any]) -> str:
+    return hashlib.sha256(json.dumps(entries, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def _entry_problem(key: Any, entry: Any) -> str | None:
+    """What is wrong with one cache entry (None: a well-formed entry)."""
+    if not isinstance(key, str) or not isinstance(entry, dict):
+        return f"entry {key!r} is not an object"
+    for name in ("task", "morphology", "controller"):
+        if not _finite(entry.get(name)):
+            return f"entry {key}: {name} = {entry.get(name)!r}; allowed: a finite number"
+    trial_ft, seeds = entry.get("trial_ft"), entry.get("seeds")
+    if not isinstance(seeds, list) or not seeds or not all(type(s) is int and s >= 0 for s in seeds):
+        return f"entry {key}: seeds = {seeds!r}; allowed: a list of seeds (integers >= 0)"
+    if not isinstance(trial_ft, list) or len(trial_ft) != len(seeds) or not all(map(_finite, trial_ft)):
+        return f"entry {key}: trial_ft; allowed: one finite number per seed"
+    return None
+
+
+def _cache_problem(doc: dict[str, Any]) -> str | None:
+    """What is wrong with a document in the cache format (None: a cache to trust)."""
+    if doc.get("version") != CACHE_VERSION:
+        return f"cache version {doc.get('version')!r}; this package reads version {CACHE_VERSION}"
+    entries = doc.get("entries")
+    if not isinstance(entries, dict):
+        return "'entries' is not an object"
+    for key, entry in entries.items():
+        problem = _entry_problem(key, entry)
+        if problem:
+            return problem
+    if doc.get("checksum") != _checksum(entries):
+        return "checksum mismatch (the file was edited or damaged)"
+    return None
+
+
+def _set_aside(path: Path) -> Path:
+    """Rename ``path`` to a free name beside it (``reevaluation.json.set-aside-N``); never overwrite."""
+    for n in range(1, 10_000):
+        target = path.with_name(f"{path.name}.set-aside-{n}")
+        if not target.exists() and not target.is_symlink():
+            path.rename(target)
+            return target
+    raise ValueError(f"{path}: cannot set it aside (too many set-aside copies beside it); move them away")
+
+
 def _load_cache(path: Path) -> dict[str, Any]:
+    """The trusted entries of a run's cache ({} if there is none).
+
+    A file that is not a cache at all is refused (it is not ours to move). A cache that is
+    damaged, edited (checksum), malformed (types, NaN) or of another version is reported in
+    one warning and set aside under a new name; nothing from it is used.
+    """
     if not path.exists():
         return {}
+    if not path.is_file():
+        raise ValueError(f"{path}: is a folder, not a re-evaluation cache; move it away (it is not overwritten)")
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError):
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError):
         doc = None
     if not isinstance(doc, dict) or doc.get("format") != CACHE_FORMAT:
         raise ValueError(f"{path}: exists and is not a re-evaluation cache; move it away (it is not overwritten)")
-    if doc.get("version") != CACHE_VERSION:
-        return {}
-    return dict(doc.get("entries", {}))
+    problem = _cache_problem(doc)
+    if problem is None:
+        return dict(doc["entries"])
+    aside = _set_aside(path)
+    warnings.warn(f"{path}: {problem}; not used: set aside as {aside.name}, the genomes are re-evaluated",
+                  stacklevel=3)
+    return {}
 
 
 def _entry_key(genome: dict[str, Any], experiment: Any, seeds: list[int]) -> str:
@@ -157,6 +224,6 @@ def reevaluate_run(run_dir: Path, trials: int, workers: int | None = None, backe
                 "task": ev.task, "morphology": ev.morphology, "controller": ev.controller,
                 "trial_ft": list(ev.trial_ft), "seeds": seeds,
             }
-        doc = {"format": CACHE_FORMAT, "version": CACHE_VERSION, "entries": cache}
+        doc = {"format": CACHE_FORMAT, "version": CACHE_VERSION, "checksum": _checksum(cache), "entries": cache}
         atomic_write_bytes(cache_path, (json.dumps(doc, indent=1) + "\n").encode())
     return results

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import csv
+import dataclasses
+import math
 from collections import defaultdict
 from pathlib import Path
 
@@ -12,40 +14,66 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from evolution.analysis.fronts import SELECTION_POINTS, Analysis  # noqa: E402
-from evolution.guard import check_output_dir  # noqa: E402
+from evolution.analysis.fronts import SELECTION_POINTS, Analysis, Comparison, nothing_to_compare  # noqa: E402
+from evolution.guard import check_output_dir, writing  # noqa: E402
 
 ENV_COLOURS = {1: "tab:blue", 2: "tab:orange", 3: "tab:red"}
 POINT_MARKERS = {"max": "^", "mean": "s", "knee": "D", "epsilon": "P"}
 
 
+def table4_cell(c: Comparison) -> str:
+    """One cell of Table 4: the superior arm and the mean difference in % of SO with p, '=' and
+    the same when not significant, or why there is no test."""
+    if c.untested:
+        return c.untested
+    if math.isnan(c.difference_percent):  # SO mean 0: no percentage; the absolute difference
+        change = f"MO − SO = {c.mo_mean - c.so_mean:+.2f}"
+    else:
+        change = f"{c.difference_percent:+.1f} %" if c.superior == "=" else f"{abs(c.difference_percent):.1f} %"
+    if c.superior == "=":
+        return f"= ({change}, p={c.p_value:.2g})"
+    return f"{c.superior} {change} (p={c.p_value:.2g})"
+
+
 def write_table4(analysis: Analysis, out: Path) -> tuple[Path, Path]:
-    rows = [c.__dict__ for c in analysis.comparisons]
+    """table4.csv (one row per environment x point x objective, with the reason for a missing
+    test in ``note``) and table4.md; with nothing to compare, the markdown is that one line."""
+    fields = [f.name for f in dataclasses.fields(Comparison)] + ["note"]
     csv_path = out / "table4.csv"
-    with open(csv_path, "w", newline="") as f:
-        if rows:
-            writer = csv.DictWriter(f, fieldnames=list(rows[0]))
-            writer.writeheader()
-            writer.writerows(rows)
+    with writing(csv_path), open(csv_path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=fields)
+        writer.writeheader()
+        writer.writerows({**c.__dict__, "note": c.untested or ""} for c in analysis.comparisons)
+    md_path = out / "table4.md"
+    empty = nothing_to_compare(analysis)
+    if empty:
+        with writing(md_path):
+            md_path.write_text(empty + "\n")
+        return md_path, csv_path
     envs = sorted({c.environment for c in analysis.comparisons})
     lines = ["| SO vs | " + " | ".join(f"env {e} ft | env {e} C" for e in envs) + " |",
              "|---|" + "---|---|" * len(envs)]
     cell = {(c.environment, c.point, c.objective): c for c in analysis.comparisons}
     for point in SELECTION_POINTS:
-        parts = []
-        for e in envs:
-            for obj in ("task", "morphology"):
-                c = cell.get((e, point, obj))
-                if c is None:
-                    parts.append("")
-                elif c.superior == "=":
-                    parts.append(f"= ({c.difference_percent:+.1f} %, p={c.p_value:.2g})")
-                else:
-                    parts.append(f"{c.superior} {abs(c.difference_percent):.1f} % (p={c.p_value:.2g})")
+        parts = [table4_cell(cell[(e, point, obj)]) if (e, point, obj) in cell else ""
+                 for e in envs for obj in ("task", "morphology")]
         lines.append(f"| {point} | " + " | ".join(parts) + " |")
-    md_path = out / "table4.md"
-    md_path.write_text("\n".join(lines) + "\n")
+    with writing(md_path):
+        md_path.write_text("\n".join(lines) + "\n")
     return md_path, csv_path
+
+
+def point_means(analysis: Analysis) -> dict[int, dict[str, tuple[float, float, float, int]]]:
+    """env -> point -> (mean ft, mean C, standard error of C, runs) over the MO runs' own
+    selection points: the values of Figure 6 and the MO samples of Table 4."""
+    table = {}
+    for env, points in sorted(analysis.run_points.items()):
+        table[env] = {}
+        for point in SELECTION_POINTS:
+            ft, c = points[point][:, 0], points[point][:, 1]
+            se = float(c.std(ddof=1) / np.sqrt(len(c))) if len(c) > 1 else 0.0
+            table[env][point] = (float(ft.mean()), float(c.mean()), se, len(c))
+    return table
 
 
 def figure4(analysis: Analysis, out: Path) -> Path:
@@ -71,7 +99,8 @@ def figure4(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="best")
     path = out / "figure4_fronts.png"
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
@@ -93,7 +122,8 @@ def figure5(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7)
     path = out / "figure5_simplicity.png"
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
@@ -104,12 +134,10 @@ def figure6(analysis: Analysis, out: Path) -> Path:
     fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
     width = 0.8 / max(len(envs), 1)
     x = np.arange(len(SELECTION_POINTS))
+    values = point_means(analysis)
     for i, env in enumerate(envs):
-        means, errs = [], []
-        for point in SELECTION_POINTS:
-            c = analysis.run_points[env][point][:, 1]
-            means.append(c.mean())
-            errs.append(c.std(ddof=1) / np.sqrt(len(c)) if len(c) > 1 else 0.0)
+        means = [values[env][p][1] for p in SELECTION_POINTS]
+        errs = [values[env][p][2] for p in SELECTION_POINTS]
         ax.bar(x + i * width, means, width, yerr=errs, capsize=3, color=ENV_COLOURS.get(env, "k"), label=f"env {env}")
     ax.set_xticks(x + width * (len(envs) - 1) / 2, SELECTION_POINTS)
     ax.set_ylabel("morphological simplicity C")
@@ -117,7 +145,8 @@ def figure6(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7)
     path = out / "figure6_points.png"
-    fig.savefig(path, dpi=110)
+    with writing(path):
+        fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
@@ -151,7 +180,17 @@ def write_report(analysis: Analysis, out: Path) -> Path:
         lines.append(f"| {r.path.name} | {'MO' if r.multi_objective else 'SO'} | {r.environment} | "
                      f"{len(r.records)} | {ft:.2f} | {trained} | {c:.1f} | "
                      f"{len(r.front) if r.multi_objective else ''} |")
-    lines += ["", "## Selection points of the merged MO fronts (ft, C)", ""]
+    lines += ["", "## Selection points", "",
+              "Two kinds, so one point has two values. Figure 6 and Table 4 use each MO run's own "
+              "selection point, averaged over the runs (the paper's Figure 6: mean and standard error); "
+              "Figure 4 marks the selection points of the merged front (the non-dominated points of all "
+              "runs together), one front whose points can lie far from the runs' average.", "",
+              "Per-run means (Figure 6, Table 4), ft / C ± standard error of C:", ""]
+    for env, pts in point_means(analysis).items():
+        cells = ", ".join(f"{p} = {ft:.2f} / {c:.1f} ± {se:.1f}" for p, (ft, c, se, _) in pts.items())
+        runs = next(iter(pts.values()))[3]
+        lines.append(f"* environment {env} ({runs} MO runs): {cells}")
+    lines += ["", "Merged front (Figure 4), (ft, C):", ""]
     for env, pts in sorted(analysis.merged_points.items()):
         cells = ", ".join(f"{p} = ({v[0]:.2f}, {v[1]:.1f})" for p, v in pts.items())
         lines.append(f"* environment {env}: {cells}")
@@ -163,5 +202,6 @@ def write_report(analysis: Analysis, out: Path) -> Path:
               f"are in `{table_csv.name}`.", "", table_md.read_text(), "## Figures", ""]
     lines += [f"![{f.stem}]({f.name})" for f in figs]
     path = out / "report.md"
-    path.write_text("\n".join(lines) + "\n")
+    with writing(path):
+        path.write_text("\n".join(lines) + "\n")
     return path

@@ -6,8 +6,8 @@ whose network has one input per possible sensor *slot* (``num_inputs`` = 10) and
 ``SensorGene`` (type, bearing, orientation, range, fov). A slot without a sensor gene
 contributes no input.
 
-Extra keys of the ``[NEATMGenome]`` config section (neat-python ``ConfigParameter``s; SPEC
-section 5 gives the original rates; with ``variation = one_operator`` each ``*_prob`` is the
+Extra keys of the ``[NEATMGenome]`` config section (neat-python ``ConfigParameter``s;
+docs/model.md §5 gives the original rates; with ``variation = one_operator`` each ``*_prob`` is the
 probability of that operator being *the* operator of an offspring, see ``evolution.reproduction.breeding``)::
 
     sensor_types             = infrared ultrasonic colour camera bottom

@@ -1,6 +1,6 @@
 """HyperNEAT-M: the substrate and the decoding of a CPPN into a controller and a morphology.
 
-Substrate (SPEC section 5, paper Figure 3): ``num_inputs`` = 10 input nodes on a circle of
+Substrate (docs/model.md §5, paper Figure 3): ``num_inputs`` = 10 input nodes on a circle of
 radius 1.5 at angles 0, 0.65, 1.30, ... (all < 2 pi), the robot's body seen from above with
 its heading along +x; two output nodes, left wheel at (-0.5, -1.875) and right wheel at
 (0.5, -1.875). Every input may link to every output. Optionally (``hidden_nodes`` > 0) a
@@ -14,7 +14,7 @@ target); every output is clipped to [-1, 1]. Decoding:
 * a link exists when |w| > ``weight_threshold`` (0.2); its weight is
   ``sign(w) (|w| - 0.2) * max_weight / (1 - 0.2)`` (max_weight = 5);
 * a node's bias is the bias-weight output queried at (0, 0, x_target, y_target), times
-  ``max_weight`` (SPEC: not thresholded); with ``bias_threshold`` (the original's choice)
+  ``max_weight`` (docs/model.md §5: not thresholded); with ``bias_threshold`` (the original's choice)
   it goes through the same threshold and rescaling as a link weight, so |b| <= 0.2 gives 0;
 * each input node's **sensor** comes from its outgoing link with the highest *signed* CPPN
   weight: type from the ``type`` output split into ``len(sensor_types)`` equal bands over

@@ -17,15 +17,26 @@ from a name, as ``gathering-compare --policy`` takes it. Policies (each carries 
   each wheel's most likely command).
 * ``ppo-sample:PATH``: the same model with actions sampled from its distribution, as in
   training (torch's generator seeded by the episode seed).
+* ``benchmarl:PATH``: a BenchMARL / TorchRL actor (IPPO, MAPPO, ...) exported by
+  ``examples/benchmarl_run.py`` (``policy.pt``, with its morphology inside); its deterministic
+  action. ``benchmarl-sample:PATH``: actions sampled as in training.
 
 Modules: ``scripted`` (random, heuristic, ``WanderTeam``), ``evolved`` (champion files),
-``learned`` (Stable-Baselines3 models).
+``learned`` (Stable-Baselines3 models), ``marl`` (BenchMARL / TorchRL policy files).
 """
 
 from __future__ import annotations
 
-from evolution.policies import evolved, learned, scripted
+from evolution.policies import evolved, learned, marl, scripted
 from evolution.policies.base import Policy
+
+KINDS = ("random", "heuristic", "wander", "champion", "ppo", "ppo-sample", "benchmarl", "benchmarl-sample")
+"""The kinds of policy name: ``KIND`` or ``KIND:PATH``."""
+
+
+def is_policy_name(spec: str) -> bool:
+    """Whether ``spec`` is written as a policy name (``wander``, ``ppo:PATH``, ...) rather than a file path."""
+    return spec.partition(":")[0] in KINDS
 
 
 def make_policy(spec: str) -> Policy:
@@ -41,8 +52,14 @@ def make_policy(spec: str) -> Policy:
         return evolved.champion_policy(arg)
     if kind in ("ppo", "ppo-sample") and arg:
         return learned.ppo_policy(arg, sample=kind == "ppo-sample")
-    raise ValueError(f"--policy {spec}: unknown policy; allowed: random, heuristic, wander, champion:PATH, "
-                     "ppo:PATH, ppo-sample:PATH")
+    if kind in ("benchmarl", "benchmarl-sample") and arg:
+        return marl.benchmarl_policy(arg, sample=kind == "benchmarl-sample")
+    raise ValueError(f"--policy {spec}: unknown policy; allowed: {POLICY_NAMES}")
 
 
-__all__ = ["Policy", "make_policy", "evolved", "learned", "scripted"]
+POLICY_NAMES = ("random, heuristic, wander, champion:PATH, ppo:PATH, ppo-sample:PATH, benchmarl:PATH, "
+                "benchmarl-sample:PATH")
+"""The names ``make_policy`` takes (for help texts and errors)."""
+
+
+__all__ = ["KINDS", "POLICY_NAMES", "Policy", "is_policy_name", "make_policy", "evolved", "learned", "marl", "scripted"]

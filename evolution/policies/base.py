@@ -1,4 +1,5 @@
-"""The ``Policy`` record every team policy is: a name, a morphology, ``act`` and ``reset``."""
+"""The ``Policy`` record every team policy is: a name, a morphology, ``act``, ``reset`` and, where
+the policy knows it, the world it was made for."""
 
 from __future__ import annotations
 
@@ -10,12 +11,17 @@ from gathering_env import Morphology
 
 @dataclass
 class Policy:
-    """A named team policy: ``act(obs (N, S)) -> wheels (N, 2)`` for its morphology."""
+    """A named team policy: ``act(obs (N, S)) -> wheels (N, 2)`` for its morphology.
+
+    ``environment``: world parameters it was evolved or trained in (``WorldConfig`` keywords,
+    e.g. ``{"environment": 1, "max_cycles": 2000}``), the defaults of ``gathering-replay``; None if unknown.
+    """
 
     name: str
     morphology: Morphology
     act: Any
     reset: Any = field(default=lambda seed: None)
+    environment: dict[str, Any] | None = None
 
 
 __all__ = ["Policy"]

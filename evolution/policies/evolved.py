@@ -11,7 +11,8 @@ def champion_policy(path: str) -> Policy:
     from evolution.run.champion import load_champion
 
     champion = load_champion(path)
-    return Policy(f"champion:{Path(path).parent.name or path}", champion.morphology, champion.controller.act)
+    return Policy(f"champion:{Path(path).parent.name or path}", champion.morphology, champion.controller.act,
+                  environment=dict(champion.environment))
 
 
 __all__ = ["champion_policy"]

@@ -4,7 +4,7 @@ SO and MO runs differ only in how parents are *selected* (NEAT fitness sharing w
 stagnation in ``NEATReproduction``, speciated NSGA-II in ``evolution.reproduction.mods``); both then breed
 each species' offspring with ``breed``, so Table 4 compares selection and nothing else.
 
-``breed`` (SPEC sections 5 and 6.5, the original's Encog scheme):
+``breed`` (docs/model.md §5 and §6.5, the original's Encog scheme):
 
 1. **truncation**: the species' candidates, best first by the arm's score (fitness in SO,
    NSGA-II rank score in MO), are cut to the best ``parent_fraction`` (0.3), at least two

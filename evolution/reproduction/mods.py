@@ -9,7 +9,7 @@ to ``neat.Config`` and put its parameters in a ``[MODSReproduction]`` section::
     progression   = round_robin    # the published serial progression; or by_front
 
 neat-python's loop evaluates the population and then calls ``reproduce``. This class keeps
-the previous parents with their objectives, so each call (SPEC section 6):
+the previous parents with their objectives, so each call (docs/model.md §6):
 
 1. pools the previous N parents with the N offspring just evaluated (2N, elitist: parents
    are never evaluated twice);

@@ -14,17 +14,23 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import re
 import signal
 import socket
+import tempfile
 import threading
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
+from datetime import datetime
+from pathlib import Path
 from typing import Any, Protocol
 
 from evolution.run.evaluate import Evaluation, evaluate
+from evolution.run.lock import drop_inherited_locks
+from evolution.run.reaper import start_reaper, stop_reaper
 
 BACKENDS = ("serial", "process", "ray")
 
@@ -105,6 +111,7 @@ def _exit_when_orphaned(parent: int) -> None:
 def _init_worker(context: EvalContext, parent: int) -> None:
     global _WORKER_CONTEXT
     _WORKER_CONTEXT = context
+    drop_inherited_locks()  # the run directory's lock stays the trainer's alone
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     # Forked workers inherit the trainer's Python signal handlers: drop them. Ctrl-C reaches
     # the whole process group and the trainer decides what to do, so workers ignore SIGINT;
@@ -216,23 +223,37 @@ class RayEvaluator:
         self._ray = ray
         self.failures: list[tuple[int, str]] = []
         self._own = not ray.is_initialized()
+        self._reaper = None
         if self._own:
             kwargs: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False,
                                       "configure_logging": False}
             if address:
                 _check_reachable(address)
                 kwargs["address"] = address
-            elif num_cpus:
-                kwargs["num_cpus"] = num_cpus
+            else:
+                if num_cpus:
+                    kwargs["num_cpus"] = num_cpus
+                # a local Ray's processes must not outlive this trainer, even a SIGKILLed one
+                self._reaper = start_reaper()
+            started = time.time()
             try:
                 ray.init(**kwargs)
             except Exception as err:  # noqa: BLE001 - Ray raises many types when it cannot start
+                self.close()
                 where = f"--ray-address {address}" if address else "--backend ray"
                 reason = (str(err).strip().splitlines() or [type(err).__name__])[-1]
-                raise ValueError(f"{where}: Ray did not start ({reason}); allowed: a reachable Ray cluster "
-                                 "address, or --backend process") from None
-        self._context_ref = ray.put(context)
-        self._task = ray.remote(_ray_evaluate).options(max_retries=max_retries, retry_exceptions=True)
+                cause = None if address else ray_log_cause(started)
+                raise ValueError(f"{where}: Ray did not start ({reason}{'; ' + cause if cause else ''}); "
+                                 "allowed: a reachable Ray cluster address, or --backend process") from None
+            except BaseException:
+                self.close()
+                raise
+        try:
+            self._context_ref = ray.put(context)
+            self._task = ray.remote(_ray_evaluate).options(max_retries=max_retries, retry_exceptions=True)
+        except BaseException:
+            self.close()
+            raise
 
     def map(self, genomes: list[Any], generation: int) -> list[Evaluation]:
         refs = [self._task.remote(self._context_ref, g, generation) for g in genomes]
@@ -247,8 +268,46 @@ class RayEvaluator:
         return results
 
     def close(self) -> None:
-        if self._own and self._ray.is_initialized():
-            self._ray.shutdown()
+        """Shut a Ray this evaluator started down, then its reaper (safe to call twice)."""
+        try:
+            if self._own and self._ray.is_initialized():
+                self._ray.shutdown()
+        finally:
+            stop_reaper(self._reaper)
+            self._reaper = None
+
+
+_RAY_LOG_LINE = re.compile(r"^\[(\S+ \S+) ([EC]) \d+ \d+\] \((\w+)\) [^:\s]+:\d+:\s*(.+)$")
+
+
+def ray_log_cause(since: float) -> str | None:
+    """The first error a local Ray started by this process logged (raylet, GCS server), if any.
+
+    Ray reports a failed start only as "node timed out during startup"; the reason (an mmap
+    refused, a port taken) is in its session logs: ``<ray temp dir>/session_*_<driver pid>/logs``.
+    """
+    root = Path(os.environ.get("RAY_TMPDIR") or tempfile.gettempdir()) / "ray"
+    found: list[tuple[str, str, Path]] = []
+    for session in root.glob(f"session_*_{os.getpid()}"):
+        try:  # session_<local date and time>_<driver pid>: only a session of this start
+            if datetime.strptime(session.name[8:34], "%Y-%m-%d_%H-%M-%S_%f").timestamp() < since - 2:
+                continue
+        except ValueError:
+            continue
+        for log in sorted((session / "logs").glob("*.[eo][ru][rt]")):  # *.err, *.out
+            try:
+                lines = log.read_text(encoding="utf-8", errors="replace").splitlines()
+            except OSError:
+                continue
+            for line in lines:
+                match = _RAY_LOG_LINE.match(line)
+                if match:
+                    found.append((match[1], f"{match[3]}: {match[4].strip()[:200]}", log))
+                    break
+    if not found:
+        return None
+    _, message, log = min(found)
+    return f"{message} (Ray's log {log})"
 
 
 def _check_reachable(address: str, timeout: float = 5.0) -> None:

@@ -1,6 +1,6 @@
 """Experiment files: one TOML file describes a run (method, objectives, budget, world).
 
-Layout (every key optional except where noted; defaults are the paper's, SPEC section 7)::
+Layout (every key optional except where noted; defaults are the paper's, docs/model.md §7)::
 
     [experiment]
     name = "S2"                  # label used in file names and the analysis
@@ -46,6 +46,7 @@ them (the description is the first comment line of the file).
 
 from __future__ import annotations
 
+import hashlib
 import math
 import re
 import tomllib
@@ -193,10 +194,13 @@ def preset_description(name: str) -> str:
 def is_preset_name(arg: str) -> bool:
     """Whether a command-line EXPERIMENT argument means a preset rather than a file.
 
-    A preset name has no path separator and no ``.toml`` suffix and is not an existing file;
-    anything else is a path, as before presets existed.
+    A preset name has no path separator and no ``.toml`` suffix and is not an existing file,
+    nor an existing folder unless it is a shipped preset's name; anything else is a path (so a
+    folder is reported as a folder, not as an unknown preset).
     """
-    return not (any(sep in arg for sep in "/\\") or arg.endswith(".toml") or Path(arg).is_file())
+    if any(sep in arg for sep in "/\\") or arg.endswith(".toml") or Path(arg).is_file():
+        return False
+    return arg in preset_names() or not Path(arg).exists()
 
 
 @dataclass(frozen=True)
@@ -229,10 +233,35 @@ class Experiment:
         return WorldConfig.from_kwargs(**self.environment)
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-safe form (experiment.json, checkpoints) that holds no absolute path, so a run
+        directory moves between folders and machines: ``neat_config`` is a shipped preset's name
+        or the file's name alone (a run uses its own copy, ``neat.cfg``),
+        ``neat_config_sha256`` identifies the file by its content, and ``source`` is the
+        experiment file's name."""
         d = asdict(self)
-        d["neat_config"] = str(self.neat_config)
+        d["neat_config"] = portable_name(self.neat_config)
+        d["neat_config_sha256"] = file_sha256(self.neat_config)
+        d["source"] = self.source if self.source.startswith("<") else Path(self.source).name
         d["objectives"] = list(self.objectives)
         return d
+
+
+def portable_name(path: Path) -> str:
+    """A neat config's name without the machine's folders: relative to the shipped presets if
+    it is one of them, else the file name."""
+    path = Path(path)
+    try:
+        return path.resolve().relative_to(CONFIG_DIR.resolve()).as_posix()
+    except ValueError:
+        return path.name
+
+
+def file_sha256(path: Path) -> str | None:
+    """SHA-256 of a file's bytes, None if it cannot be read (a resumed run's source may be gone)."""
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError:
+        return None
 
 
 _EXPERIMENT_KEYS = {f.name for f in fields(Experiment)} - {"environment", "substrate", "source"}

@@ -18,7 +18,7 @@ from typing import Any
 import neat
 
 from evolution.run.champion import save_champion
-from evolution.run.checkpoint import save_checkpoint
+from evolution.run.checkpoint import atomic_write_bytes, save_checkpoint
 from evolution.run.evaluate import Evaluation, decode_genome
 from evolution.run.experiment import Experiment
 from evolution.run.stats import append_stats, generation_record, write_stats
@@ -61,8 +61,9 @@ class RunRecorder:
     def write_new_run(self, population: neat.Population) -> None:
         """The files of a new run: experiment.json, neat.cfg and the first checkpoint."""
         self.run_dir.mkdir(parents=True, exist_ok=True)
-        (self.run_dir / "experiment.json").write_text(json.dumps(self.experiment.to_dict(), indent=1) + "\n")
-        (self.run_dir / "neat.cfg").write_text(self.neat_cfg_text, encoding="utf-8")
+        atomic_write_bytes(self.run_dir / "experiment.json",
+                           (json.dumps(self.experiment.to_dict(), indent=1) + "\n").encode())
+        atomic_write_bytes(self.run_dir / "neat.cfg", self.neat_cfg_text.encode())
         self.save_checkpoint(population)
 
     def rewrite_stats(self) -> None:

@@ -5,6 +5,9 @@ checkpoint whose experiment matches ``experiment.json``, the experiment and the 
 deleted ``experiment.json``, ``neat.cfg``, ``stats.jsonl`` and ``champion.json`` are rebuilt
 from the checkpoint. ``resume_from`` a checkpoint of another run directory continues that run
 into a missing or empty folder. Anything else raises ``UsageError`` before a file is written.
+
+One writer per run directory: ``evolution.run.lock.RunLock`` is taken before the first file
+is written and held until the run ends; a second writer is refused naming the holder's PID.
 """
 
 from __future__ import annotations
@@ -12,6 +15,7 @@ from __future__ import annotations
 import json
 import random
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -19,11 +23,12 @@ import neat
 
 from evolution.guard import UsageError, check_output_dir
 from evolution.run.champion import read_json
-from evolution.run.checkpoint import CheckpointError, load_checkpoint
+from evolution.run.checkpoint import CheckpointError, atomic_write_bytes, load_checkpoint
 from evolution.run.experiment import Experiment, ExperimentError, experiment_from_run
+from evolution.run.lock import LOCK_FILE
 from evolution.run.neat_setup import make_neat_config, substrate_for
 from evolution.run.recorder import CHECKPOINT_DIR, RunRecorder, checkpoints_in
-from evolution.run.stats import read_stats
+from evolution.run.stats import check_generations, read_stats
 
 #: What a resumed run must share with the run it continues (``generations`` may grow).
 RUN_IDENTITY = ("method", "objectives", "seed", "population", "trials", "environment", "substrate")
@@ -35,13 +40,19 @@ def run_dir_of(checkpoint: Path) -> Path | None:
     return checkpoint.parent.parent if checkpoint.parent.name == CHECKPOINT_DIR else None
 
 
-def new_run(experiment: Experiment, run_dir: Path) -> tuple[neat.Population, RunRecorder]:
-    """A new population and its recorder, after checking that ``run_dir`` may receive a run
-    (nothing is written: ``RunRecorder.write_new_run`` does that once the backend is up)."""
+def check_new_run_dir(run_dir: Path) -> None:
+    """``run_dir`` may receive a new run: missing, empty, or holding only a lock file."""
     holds_run = (run_dir / CHECKPOINT_DIR).is_dir()
-    check_output_dir(run_dir, what="run directory",
+    check_output_dir(run_dir, owned=(LOCK_FILE,), what="run directory",
                      hint=f"it holds a run: continue it with gathering-evolve --resume {run_dir}"
                      if holds_run else "choose another --out")
+
+
+def new_run(experiment: Experiment, run_dir: Path) -> tuple[neat.Population, RunRecorder]:
+    """A new population and its recorder, after checking that ``run_dir`` may receive a run
+    (nothing is written: ``RunRecorder.write_new_run`` does that once the backend is up and
+    the run directory is locked; check the folder again then)."""
+    check_new_run_dir(run_dir)
     config = make_neat_config(experiment)
     neat_cfg_text = Path(experiment.neat_config).read_text(encoding="utf-8")
     population = neat.Population(config, seed=experiment.seed)
@@ -54,7 +65,7 @@ def find_checkpoint(run_dir: Path, resume_from: Path | None) -> tuple[Path, dict
         home = run_dir_of(resume_from)
         if home is None or home.resolve() != run_dir.resolve():
             # continuing another run's checkpoint: into a fresh folder only
-            check_output_dir(run_dir, what="run directory",
+            check_output_dir(run_dir, owned=(LOCK_FILE,), what="run directory",
                              hint=f"--resume-from continues {resume_from} into a new folder, or into "
                                   "the run directory it belongs to")
         return resume_from, load_checkpoint(resume_from)
@@ -94,12 +105,14 @@ def _check_identity(path: Path, saved: dict[str, Any], other: Any, what: Path | 
 
 
 def restore_run(run_dir: Path, experiment: Experiment | None, resume_from: Path | None,
-                overrides: dict[str, Any] | None) -> tuple[neat.Population, RunRecorder, bool]:
-    """(population, recorder, finished) of a verified run to resume; missing files rebuilt.
+                overrides: dict[str, Any] | None
+                ) -> tuple[neat.Population, RunRecorder, bool, Callable[[], None]]:
+    """(population, recorder, finished, write) of a verified run to resume (nothing written).
 
-    ``experiment`` None: the run's own experiment (from its files) with ``overrides``. A
-    finished run only gets its missing files back; a continued one is reset to the checkpoint
-    (later generations will be recomputed identically).
+    ``write()`` writes back the missing files (call it holding the run's lock, once the
+    backend is up). ``experiment`` None: the run's own experiment (from its files) with
+    ``overrides``. A finished run only gets its missing files back; a continued one is reset
+    to the checkpoint (later generations will be recomputed identically).
     """
     path, state = find_checkpoint(run_dir, resume_from)
     saved = state.get("experiment")
@@ -119,9 +132,10 @@ def restore_run(run_dir: Path, experiment: Experiment | None, resume_from: Path 
                                          overrides, neat_config=own_cfg if own_cfg.is_file() else None)
     _check_identity(path, saved, experiment.to_dict(), None)
     stats_path, champion_path = run_dir / "stats.jsonl", run_dir / "champion.json"
+    on_disk = _check_stats_file(stats_path)
     records = state.get("records")
     if records is None:  # checkpoint of an older version: statistics only in stats.jsonl
-        records = [r for r in read_stats(stats_path) if r.get("generation", -1) < population.generation]
+        records = [r for r in on_disk if r.get("generation", -1) < population.generation]
         if len(records) != population.generation:
             raise CheckpointError(
                 f"{stats_path}: holds {len(records)} of the {population.generation} generations before "
@@ -136,11 +150,26 @@ def restore_run(run_dir: Path, experiment: Experiment | None, resume_from: Path 
     recorder = RunRecorder(run_dir, experiment, config, substrate_for(experiment), state.get("neat_cfg"),
                            records, best, champion_state)
     finished = population.generation >= experiment.generations or recorder.converged()
-    _rebuild_files(recorder, recorded, finished)
     home = run_dir_of(path)
-    if home is None or home.resolve() != run_dir.resolve():
-        recorder.save_checkpoint(population)  # a run continued in a new folder resumes from there
-    return population, recorder, finished
+    elsewhere = home is None or home.resolve() != run_dir.resolve()
+
+    def write() -> None:
+        _rebuild_files(recorder, recorded, finished)
+        if elsewhere:
+            recorder.save_checkpoint(population)  # a run continued in a new folder resumes from there
+
+    return population, recorder, finished, write
+
+
+def _check_stats_file(path: Path) -> list[dict[str, Any]]:
+    """The records of a run's ``stats.jsonl`` if it is readable and one sequence of generations."""
+    hint = " (delete it to have it rebuilt from the checkpoint)"
+    try:
+        records = read_stats(path)
+        check_generations(path, records)
+    except ValueError as err:
+        raise ValueError(f"{err}{hint}") from None
+    return records
 
 
 def _rebuild_files(recorder: RunRecorder, recorded: Any, finished: bool) -> None:
@@ -148,10 +177,10 @@ def _rebuild_files(recorder: RunRecorder, recorded: Any, finished: bool) -> None
     run_dir, experiment = recorder.run_dir, recorder.experiment
     run_dir.mkdir(parents=True, exist_ok=True)
     if recorded is None or (not finished and recorded.get("generations") != experiment.generations):
-        (run_dir / "experiment.json").write_text(json.dumps(experiment.to_dict(), indent=1) + "\n")
+        atomic_write_bytes(run_dir / "experiment.json", (json.dumps(experiment.to_dict(), indent=1) + "\n").encode())
     if not (run_dir / "neat.cfg").exists():
         if recorder.neat_cfg_text is not None:
-            (run_dir / "neat.cfg").write_text(recorder.neat_cfg_text, encoding="utf-8")
+            atomic_write_bytes(run_dir / "neat.cfg", recorder.neat_cfg_text.encode())
         else:
             warnings.warn(f"{run_dir / 'neat.cfg'}: missing and this (older) checkpoint cannot rebuild it; "
                           "the run goes on with the config stored in the checkpoint", stacklevel=3)
@@ -161,4 +190,5 @@ def _rebuild_files(recorder: RunRecorder, recorded: Any, finished: bool) -> None
         recorder.write_champion(**recorder.champion_state)
 
 
-__all__ = ["RUN_IDENTITY", "find_checkpoint", "new_run", "restore_run", "run_dir_of"]
+__all__ = ["RUN_IDENTITY", "check_new_run_dir", "find_checkpoint", "new_run", "restore_run",
+           "run_dir_of"]

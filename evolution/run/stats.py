@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from evolution.guard import writing
 from evolution.run.checkpoint import atomic_write_bytes
 from evolution.run.evaluate import Evaluation
 from gathering_env import SENSOR_TYPES
@@ -93,6 +94,21 @@ def read_stats(path: Path) -> list[dict[str, Any]]:
     return records
 
 
+def check_generations(path: Path, records: Sequence[dict[str, Any]]) -> None:
+    """Raise ``ValueError`` unless the records are generations 0, 1, 2, ... in order (one run).
+
+    Two writers in one run directory, or a resume of a run that was still running, leave
+    repeated or interleaved generations; such statistics are not one run's record.
+    """
+    generations = [r.get("generation") for r in records]
+    for i, g in enumerate(generations):
+        if type(g) is not int or g != i:
+            shown = ",".join(str(x) for x in generations[:12]) + (",..." if len(generations) > 12 else "")
+            raise ValueError(f"{path}: record {i + 1} is generation {g!r}, expected {i}; the generations "
+                             f"({shown}) are not one run's record (two writers in one run directory?); allowed: "
+                             "one record per generation, 0, 1, 2, ... in order")
+
+
 def write_stats(path: Path, records: Sequence[dict[str, Any]]) -> None:
     """Rewrite ``stats.jsonl`` and its ``stats.csv`` sibling atomically."""
     path = Path(path)
@@ -104,7 +120,7 @@ def write_stats(path: Path, records: Sequence[dict[str, Any]]) -> None:
 def append_stats(path: Path, record: dict[str, Any]) -> None:
     """Append one record to ``stats.jsonl`` (fsync'ed) and refresh ``stats.csv``."""
     path = Path(path)
-    with open(path, "a", encoding="utf-8") as f:
+    with writing(path), open(path, "a", encoding="utf-8") as f:
         f.write(json.dumps(record, allow_nan=False) + "\n")
         f.flush()
         os.fsync(f.fileno())

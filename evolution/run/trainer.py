@@ -8,6 +8,7 @@ One call of ``Trainer.run()`` evolves an ``Experiment`` into a run directory::
     RUN_DIR/checkpoints/gen-NNNN.ckpt  state before generation NNNN is evaluated
     RUN_DIR/champion.json          best genome so far by task performance (JSON, no pickle)
     RUN_DIR/stats.png              fitness and simplicity over generations (at the end)
+    RUN_DIR/.lock                  the writer's lock and PID (evolution.run.lock)
 
 neat-python's ``Population.run(fitness, 1)`` is called once per generation: it evaluates the
 population through our fitness function (which hands the genomes to the backend), reports,
@@ -29,12 +30,14 @@ from typing import Any
 
 import neat
 
-from evolution.guard import UsageError, describe_os_error
+from evolution.guard import UsageError, describe_os_error, writing
 from evolution.run.backends import EvalContext, make_evaluator
 from evolution.run.evaluate import Evaluation
 from evolution.run.experiment import Experiment
+from evolution.run.lock import RunLock
 from evolution.run.recorder import RunRecorder, convergence_target
-from evolution.run.rundir import new_run, restore_run
+from evolution.run.rundir import check_new_run_dir, new_run, restore_run
+from gathering_env.compiled.engine import announce_compile
 
 
 @dataclass
@@ -81,10 +84,11 @@ class Trainer:
             ``experiment`` is None (only ``generations`` and ``name`` may differ from the run).
 
     Output folder: the rules of ``evolution.run.rundir`` (a new run into a missing or empty
-    folder; a resumed run verified before anything is written). The record and every file
+    folder; a resumed run verified before anything is written; one writer at a time, by the
+    run directory's lock, ``evolution.run.lock``). The record and every file
     written from it: ``evolution.run.recorder.RunRecorder`` (``self.recorder``).
 
-    SIGINT/SIGTERM: the first signal lets the current generation finish (its statistics and
+    SIGINT/SIGTERM/SIGHUP: the first signal lets the current generation finish (its statistics and
     checkpoint are written) and then stops; a second one abandons the generation at once. Either
     way the run resumes from its last checkpoint.
     """
@@ -115,23 +119,40 @@ class Trainer:
     def records(self) -> list[dict[str, Any]]:
         return self.recorder.records if self.recorder is not None else []
 
-    def _prepare(self) -> tuple[neat.Population, bool, bool]:
-        """(population, finished, unwritten): a verified resumed run, or a new one not yet written."""
+    def _prepare(self) -> tuple[neat.Population, bool, Any]:
+        """(population, finished, write): a verified run, nothing written yet; ``write()``
+        writes its files (a new run's first ones, a resumed run's missing ones)."""
         if self.resume:
-            population, self.recorder, finished = restore_run(self.run_dir, self.experiment, self.resume_from,
-                                                              self.overrides)
+            population, self.recorder, finished, write = restore_run(self.run_dir, self.experiment,
+                                                                     self.resume_from, self.overrides)
             self.experiment = self.recorder.experiment
-            return population, finished, False
+            return population, finished, write
         population, self.recorder = new_run(self.experiment, self.run_dir)
-        return population, False, True
+
+        def write() -> None:
+            check_new_run_dir(self.run_dir)  # again, now that it is locked: no other run got in first
+            self.recorder.write_new_run(population)
+
+        return population, False, write
 
     # ------------------------------------------------------------------ loop
     def run(self) -> RunResult:
-        population, finished, unwritten = self._prepare()
-        exp, recorder = self.experiment, self.recorder
+        """Evolve; the run directory is locked (``evolution.run.lock.RunLock``) throughout."""
+        self._lock = RunLock(self.run_dir)
+        try:
+            self._lock.acquire(create=False)  # a run directory in use is refused before any work
+            return self._run()
+        finally:
+            self._lock.release()
+
+    def _run(self) -> RunResult:
+        population, finished, write = self._prepare()
+        exp, recorder, lock = self.experiment, self.recorder, self._lock
         target = convergence_target(exp)
         if finished:
             # Nothing left to evolve: only rebuild what is missing.
+            lock.acquire()
+            write()
             if exp.multi_objective and not any((self.run_dir / "front").glob("genome-*.json")):
                 recorder.write_front(population)
             if not (self.run_dir / "stats.png").exists():
@@ -145,15 +166,17 @@ class Trainer:
         # Starting a backend (Ray in particular) may draw from Python's global random generator,
         # which is neat-python's: keep the lineage independent of the backend.
         random_state = random.getstate()
+        if dict(exp.environment).get("kernel", "compiled") == "compiled":
+            announce_compile()  # here, once: not from every worker, nor across the progress bar
         evaluator = self._evaluator = make_evaluator(context, self.workers, self.backend, self.ray_address,
                                                      self.max_retries)
         random.setstate(random_state)
-        if unwritten:  # a new run: nothing is written before the backend is up
-            try:
-                recorder.write_new_run(population)
-            except BaseException:
-                evaluator.close()
-                raise
+        try:  # nothing is written before the backend is up and the run directory is locked
+            lock.acquire()
+            write()
+        except BaseException:
+            evaluator.close()
+            raise
         previous_handlers = self._install_signal_handlers()
         bar = None
         if self.progress:
@@ -171,6 +194,7 @@ class Trainer:
                 self._generation = generation
                 self._population = population
                 population.run(self._fitness, 1)
+                self._check_run_dir(generation)
                 record = recorder.record(population, generation, species_count, time.perf_counter() - start,
                                          self._current, self._current_genomes, self._failures, threshold)
                 recorder.save_checkpoint(population)
@@ -182,6 +206,7 @@ class Trainer:
                     break
                 if self.stop_requested:
                     break
+            self._check_run_dir(population.generation)
         except OSError as err:
             raise RunFailed(f"{describe_os_error(err)}; the run stopped at generation {population.generation}: "
                             f"fix it and continue with gathering-evolve --resume {self.run_dir}") from None
@@ -193,7 +218,17 @@ class Trainer:
         if exp.multi_objective:
             recorder.write_front(population)
         recorder.plot()
+        self._check_run_dir(population.generation)
         return self._result(converged, interrupted=self.stop_requested)
+
+    def _check_run_dir(self, generation: int) -> None:
+        """Stop (no success reported) if the run directory was deleted or replaced under the run."""
+        try:
+            self._lock.check()
+        except FileNotFoundError:
+            raise RunFailed(f"{self.run_dir}: the run directory was deleted or replaced while the run was writing "
+                            f"it (at generation {generation}); the run stopped and its record is incomplete; "
+                            "allowed: leave a run directory alone while it runs (start the run again)") from None
 
     def _result(self, converged: bool, interrupted: bool = False, already_finished: bool = False) -> RunResult:
         recorder = self.recorder
@@ -218,7 +253,7 @@ class Trainer:
                   "(again to abandon it); resume with --resume", flush=True)
 
         previous = {}
-        for sig in (signal.SIGINT, signal.SIGTERM):
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):  # SIGHUP: the terminal closed
             previous[sig] = signal.signal(sig, request_stop)
         return previous
 
@@ -243,7 +278,7 @@ class Trainer:
         evaluations = self._evaluator.map([g for _, g in genomes], self._generation)
         self._current = {}
         for key, error in self._evaluator.failures:
-            with open(self.run_dir / "errors.log", "a", encoding="utf-8") as log:
+            with writing(self.run_dir / "errors.log"), open(self.run_dir / "errors.log", "a", encoding="utf-8") as log:
                 log.write(f"generation {self._generation} genome {key}: {error}\n")
         self._failures = len(self._evaluator.failures)
         if genomes and self._failures == len(genomes):

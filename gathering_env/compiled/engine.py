@@ -17,6 +17,7 @@ out: they are not stepped and keep their last state until ``reset_world``.
 
 from __future__ import annotations
 
+import sys
 import time
 from collections.abc import Sequence
 
@@ -27,6 +28,28 @@ from ..rewards import RewardShaper
 from ..sensors import Morphology
 from ..world import STATE_ARRAYS, GatheringWorld
 from . import kernels
+
+COMPILE_SECONDS = 10
+"""About how long the first compile of the kernels takes on one core of a 2-core machine
+(measured 7-9 s; once per installation, numba caches the machine code on disk)."""
+_announced = False
+
+
+def announce_compile(stream=None) -> bool:
+    """Print one line to ``stream`` (stderr) if the kernels have no usable cache yet and will be
+    compiled on first use; once per process. Returns whether the line was printed."""
+    global _announced
+    if _announced:
+        return False
+    _announced = True
+    try:  # numba's cache index: empty when missing or stale (source changed)
+        cold = any(not d._cache._cache_file._load_index()
+                   for d in (kernels.sense, kernels.drive, kernels.settle, kernels.gathered_blocks))
+    except Exception:  # another numba layout: say nothing rather than guess
+        return False
+    if cold:
+        print(f"compiling the simulation kernels once, ~{COMPILE_SECONDS} s", file=stream or sys.stderr, flush=True)
+    return cold
 
 
 class CompiledWorlds:
@@ -42,6 +65,7 @@ class CompiledWorlds:
     """
 
     def __init__(self, config: WorldConfig, num_worlds: int) -> None:
+        announce_compile()
         self.config = config
         self.num_worlds = int(num_worlds)
         self.params, self.flags = kernels.world_params(config)

@@ -1,6 +1,6 @@
 """Team heuristics as array operations: pickup detection, attached-robot drive, avoidance.
 
-* **Pickup** (on by default): a robot whose pickup box (``pickup_box_width``
+* **Pickup** (docs/model.md §2, on by default): a robot whose pickup box (``pickup_box_width``
   wide, ``pickup_box_depth`` deep, in front of its rim, or with ``pickup_box = "centre"``
   centred on the robot's centre as in the original code) holds an ungathered block with a
   free anchor attaches to it (``GatheringWorld.try_attach``).

@@ -5,7 +5,7 @@ static block data; ``SensorBank.read(...)`` then turns the current poses into th
 ``(num_robots, num_sensors)`` observation matrix with a fixed number of numpy operations
 (no Python loop over robots, sensors or objects).
 
-Geometry (SPEC section 3). Sensor *s* of robot *i* sits on the rim at
+Geometry (docs/model.md §3). Sensor *s* of robot *i* sits on the rim at
 ``p_i + r * (cos(a_i + bearing_s), sin(a_i + bearing_s))`` and looks along
 ``a_i + bearing_s + orientation_s``. An object (robot disc or square block) is seen when its
 nearest point to the mount lies inside the cone (half-angle fov/2 about the axis) and

@@ -21,7 +21,7 @@ option with a picture):
 Render options (``Renderer(...)``, ``parallel_env(render_options={...})``,
 ``env.render(**options)``, ``gathering-replay --cones/--view/--size/--trail/--no-panel``):
 
-``size_px``      side of the square arena view in pixels (>= 64); the panel adds width.
+``size_px``      side of the square arena view in pixels (64..4096); the panel adds width.
 ``cones``        ``"auto"`` (default), ``"all"``, ``"none"`` or robot indices (``[3]``, ``"0,3"``).
                  ``"auto"`` is ``"all"`` while the team's summed cone area is at most
                  ``AUTO_CONES_COVER`` of the arena, otherwise the cones of one robot (the followed
@@ -53,7 +53,7 @@ Modules (every public name is re-exported here; import from ``gathering_env.rend
 ``panel``     the information panel: counts, sparkline, morphology table, legend, ``KEYS``.
 ``window``    the ``"human"`` window: showing frames, the keys.
 ``figures``   ``film_strip``, ``sensor_layout``.
-``export``    ``save_png``, ``save_video``.
+``export``    ``save_png``, ``save_video``, ``VideoWriter`` (frames streamed to the file).
 """
 
 from .drawing import (
@@ -82,7 +82,7 @@ from .drawing import (
     morphology_rows,
     team_cone_cover,
 )
-from .export import save_png, save_video
+from .export import VideoWriter, save_png, save_video
 from .figures import film_strip, sensor_layout
 from .options import (
     AUTO_CONES_COVER,
@@ -142,4 +142,5 @@ __all__ = [
     "sensor_layout",
     "save_png",
     "save_video",
+    "VideoWriter",
 ]

@@ -26,6 +26,7 @@ from .drawing import (
     _Text,
 )
 from .export import _check_frames
+from .options import MAX_SIZE_PX, MIN_SIZE_PX
 
 
 def film_strip(frames: Sequence[np.ndarray], captions: Sequence[str] | None = None,
@@ -75,8 +76,9 @@ def sensor_layout(morphology: Morphology | Sequence, size_px: int = 480, title: 
         ``(size_px, size_px + table width, 3)`` uint8.
     """
     morphology = Morphology.coerce(morphology)
-    if isinstance(size_px, bool) or not isinstance(size_px, (int, np.integer)) or size_px < 64:
-        raise ValueError(f"sensor_layout: size_px={size_px!r}; allowed: an integer >= 64")
+    if (isinstance(size_px, bool) or not isinstance(size_px, (int, np.integer))
+            or not MIN_SIZE_PX <= size_px <= MAX_SIZE_PX):
+        raise ValueError(f"sensor_layout: size_px={size_px!r}; allowed: an integer in {MIN_SIZE_PX}..{MAX_SIZE_PX}")
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     import pygame as pg
 

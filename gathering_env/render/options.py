@@ -14,6 +14,9 @@ from typing import Any
 import numpy as np
 
 DEFAULT_SIZE_PX = 640
+MIN_SIZE_PX, MAX_SIZE_PX = 64, 4096
+"""Bounds of ``size_px``: a 4096-pixel frame (with its panel) is about 70 MB in pygame and numpy;
+larger sizes end in pygame's out-of-memory error instead of a picture."""
 DEFAULT_MIN_ROBOT_PX = 4
 AUTO_CONES_COVER = 0.5
 """``cones="auto"`` shows every robot's cones while their summed area is at most this
@@ -102,8 +105,9 @@ class RenderOptions:
         values: dict[str, Any] = {}
         for name, value in options.items():
             if name == "size_px":
-                if not _is_int(value) or value < 64:
-                    raise RenderOptionError("size_px", f"{value!r} is not an integer >= 64", "an integer >= 64")
+                if not _is_int(value) or not MIN_SIZE_PX <= value <= MAX_SIZE_PX:
+                    raise RenderOptionError("size_px", f"{value!r} is not an integer in {MIN_SIZE_PX}..{MAX_SIZE_PX}",
+                                            f"an integer in {MIN_SIZE_PX}..{MAX_SIZE_PX} (pixels)")
                 value = int(value)
             elif name == "cones":
                 value = parse_cones(value, num_robots)

@@ -42,9 +42,7 @@ from stable_baselines3.common.vec_env.base_vec_env import VecEnv, VecEnvIndices
 
 from ..sensors import Morphology
 from ..vector import VectorSimulation
-
-SEED_LIMIT = 2**31
-"""Episode seeds are drawn uniformly from [0, SEED_LIMIT)."""
+from .seeds import SEED_LIMIT, check_seed, episode_seeds
 
 MAX_WHEEL_LEVELS = 101
 """Upper bound on ``wheel_levels`` (commands per wheel of the discrete action space)."""
@@ -61,9 +59,46 @@ def action_space(wheel_levels: int | None) -> spaces.Space:
     return spaces.MultiDiscrete([int(wheel_levels)] * 2)
 
 
+def check_actions(actions: Any, space: spaces.Space, num_envs: int) -> np.ndarray:
+    """``actions`` as an array of shape ``(num_envs, 2)``, or ``ValueError`` saying what is allowed.
+
+    A ``MultiDiscrete([K, K])`` action must be integers 0..K-1 (an integer array, or floats
+    with integer values): -1 is not "the last level" and 2.7 is not rounded. A ``Box`` action
+    must be finite. The shape must be exactly ``(num_envs, 2)``: a transposed ``(2, num_envs)``
+    array would scramble the robots' commands, so it is refused.
+    """
+    arr = np.asarray(actions)
+    if arr.shape != (num_envs, 2):
+        hint = " (transposed? one row per sub-environment)" if arr.shape == (2, num_envs) else ""
+        raise ValueError(f"actions: shape {arr.shape}{hint}; allowed: shape ({num_envs}, 2), one (left, right) "
+                         "row per sub-environment")
+    if isinstance(space, spaces.MultiDiscrete):
+        k = int(space.nvec[0])
+        allowed = f"integers 0..{k - 1} (wheel commands {', '.join(f'{v:g}' for v in _levels(k))})"
+        if arr.dtype == bool or not (np.issubdtype(arr.dtype, np.integer) or np.issubdtype(arr.dtype, np.floating)):
+            raise ValueError(f"actions: dtype {arr.dtype}; allowed: {allowed}")
+        if np.issubdtype(arr.dtype, np.floating):
+            bad = ~np.isfinite(arr) | (arr != np.round(arr))
+            if bad.any():
+                value = arr[tuple(np.argwhere(bad)[0])].item()
+                raise ValueError(f"actions: {value!r} is not an integer; allowed: {allowed}")
+        out = (arr < 0) | (arr > k - 1)
+        if out.any():
+            row, col = np.argwhere(out)[0]
+            raise ValueError(f"actions[{row}, {col}] = {arr[row, col].item()!r} is out of range; allowed: {allowed}")
+        return arr.astype(np.int64)
+    if not np.issubdtype(arr.dtype, np.number) or arr.dtype == bool:
+        raise ValueError(f"actions: dtype {arr.dtype}; allowed: finite numbers in [-1, 1]")
+    if not np.isfinite(arr).all():
+        row, col = np.argwhere(~np.isfinite(arr))[0]
+        raise ValueError(f"actions[{row}, {col}] = {arr[row, col].item()!r}; allowed: finite numbers in [-1, 1]")
+    return arr
+
+
 def wheel_commands(actions: np.ndarray, space: spaces.Space) -> np.ndarray:
-    """Wheel commands in [-1, 1] for actions of ``space``: a ``MultiDiscrete([K, K])`` action
-    picks among K evenly spaced commands; a ``Box`` action is the command itself (as float64)."""
+    """Wheel commands in [-1, 1] for (checked, ``check_actions``) actions of ``space``: a
+    ``MultiDiscrete([K, K])`` action picks among K evenly spaced commands; a ``Box`` action is
+    the command itself (as float64)."""
     actions = np.asarray(actions)
     if isinstance(space, spaces.MultiDiscrete):
         return _levels(int(space.nvec[0]))[actions.astype(np.int64)]
@@ -102,7 +137,7 @@ class GatheringVecEnv(VecEnv):
         self.num_worlds, self.num_robots = self.sim.num_worlds, self.config.num_robots
         observation_space = spaces.Box(0.0, 1.0, shape=(len(self.sim.morphology),), dtype=np.float32)
         super().__init__(self.num_worlds * self.num_robots, observation_space, actions)
-        self._seed = _check_seed(seed)
+        self._seed = check_seed(seed)
         self._rng = np.random.default_rng(self._seed)
         self._actions: np.ndarray | None = None
         self._team_return = np.zeros(self.num_worlds)
@@ -110,7 +145,7 @@ class GatheringVecEnv(VecEnv):
     # ------------------------------------------------------------------ VecEnv API
     def seed(self, seed: int | None = None) -> list[int | None]:
         """Seed the episode-seed generator; takes effect at the next ``reset()``."""
-        self._seed = _check_seed(seed)
+        self._seed = check_seed(seed)
         self._rng = np.random.default_rng(self._seed)
         return [self._seed] * self.num_envs
 
@@ -121,7 +156,7 @@ class GatheringVecEnv(VecEnv):
         return obs.reshape(self.num_envs, -1)
 
     def step_async(self, actions: np.ndarray) -> None:
-        self._actions = np.asarray(actions)
+        self._actions = check_actions(actions, self.action_space, self.num_envs)
 
     def step_wait(self):
         if self._actions is None:
@@ -166,7 +201,7 @@ class GatheringVecEnv(VecEnv):
 
     # ------------------------------------------------------------------ helpers
     def _episode_seeds(self, count: int) -> list[int]:
-        return [int(s) for s in self._rng.integers(0, SEED_LIMIT, count)]
+        return episode_seeds(self._rng, count)
 
     def _indices(self, indices: VecEnvIndices) -> list[int]:
         if indices is None:
@@ -176,10 +211,4 @@ class GatheringVecEnv(VecEnv):
         return list(indices)
 
 
-def _check_seed(seed: Any) -> int | None:
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0):
-        raise ValueError(f"seed={seed!r}; allowed: a non-negative integer or None")
-    return None if seed is None else int(seed)
-
-
-__all__ = ["GatheringVecEnv", "action_space", "wheel_commands"]
+__all__ = ["SEED_LIMIT", "GatheringVecEnv", "action_space", "check_actions", "wheel_commands"]

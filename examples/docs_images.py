@@ -1,0 +1,183 @@
+"""Regenerate every picture of docs/ from the commands that make them, so none goes stale.
+
+    make docs-images                                    # the pictures this repository can make alone
+    python examples/docs_images.py [--only gallery,random-episode] [--champion out/quick/champion.json]
+    python examples/docs_images.py --evidence out/evidence-fidelity     # + the evidence pictures
+    python examples/docs_images.py --rl out/rl                          # + the RL pictures
+
+``STEPS`` lists every picture of docs/ with the step that makes it (tests/test_docs_images.py
+checks that the list and the pictures in docs/ are the same). The steps:
+
+* ``gallery`` (docs/img/render-*.png): ``examples/render_gallery.py`` on a champion, by default
+  the one of ``make demo``'s run (out/quick/champion.json; evolved first if missing);
+* ``random-episode`` (docs/random_episode.png): the last frame of ``examples/random_episode.py``;
+* ``evolved-team`` (docs/evolved_team.png): ``gathering-replay --png`` of the S2-seed1 champion
+  of the reduced evidence run; needs ``--evidence DIR`` (the run directories of
+  docs/evidence/README.md);
+* ``evidence`` (docs/evidence/figure*.png, with the report they belong to): ``gathering-analyze``
+  of those runs; needs ``--evidence DIR``;
+* ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
+  docs/rl/README.md; needs ``--rl DIR`` (the runs) and the demo champion.
+
+Steps whose inputs are not given are skipped with a line saying what they need: the evidence and
+RL runs take hours. Everything is drawn by the current renderer and plotting code.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+DOCS = ROOT / "docs"
+PICTURE_SUFFIXES = (".png", ".gif", ".jpg", ".jpeg", ".svg", ".mp4")
+GALLERY = ("default", "cameras-auto", "cameras-all", "cones-robots", "zone", "follow", "trail", "small",
+           "strip", "sensors", "human")
+EVIDENCE_RUNS = ("S2-seed1", "S2-seed2", "M2-seed1", "M2-seed2")
+EVIDENCE_FIGURES = ("figure4_fronts.png", "figure5_simplicity.png", "figure6_points.png")
+# learning curves of single PPO runs shown in docs/rl/README.md: picture -> run directory
+RL_CURVES = {
+    "curve-oldbonus-shaped-team-env1.png": "ppo-oldbonus-shaped-team-env1",
+    "curve-oldbonus-shaped-local-env1.png": "ppo-oldbonus-shaped-local-env1",
+    "curve-ent0-oldbonus-shaped-team-env1.png": "ppo-ent0-oldbonus-shaped-team-env1",
+}
+RL_FIGURES = tuple(f"compare-env{e}-{s}.png" for e in (1, 2) for s in (2000, 10000)) + \
+    ("curves-env1.png", "curves-env2.png")
+
+
+@dataclass(frozen=True)
+class Step:
+    outputs: tuple[str, ...]        # pictures, relative to docs/
+    needs: str | None               # None, "evidence", "rl" or "learning"
+    make: Callable[[argparse.Namespace], None]
+
+
+def run(*command: str | Path) -> None:
+    """Run a command from the repository root with this interpreter's tools; stop on failure."""
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy",
+           "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
+    print("+", " ".join(str(c) for c in command), flush=True)
+    subprocess.run([str(c) for c in command], cwd=ROOT, env=env, check=True)
+
+
+def cli(name: str) -> list[str]:
+    """A console script of this checkout, run through this interpreter."""
+    module, function = {"gathering-evolve": ("evolution.cli", "run_evolve"),
+                        "gathering-replay": ("evolution.cli", "run_replay"),
+                        "gathering-analyze": ("evolution.cli", "run_analyze")}[name]
+    return [sys.executable, "-c", f"import sys; from {module} import {function} as f; sys.argv[0] = {name!r}; f()"]
+
+
+def demo_champion(args: argparse.Namespace) -> Path:
+    if args.champion is not None:
+        return args.champion
+    champion = ROOT / "out" / "quick" / "champion.json"
+    if not champion.is_file():  # make demo's run
+        run(*cli("gathering-evolve"), "configs/quick.toml", "--out", "out/quick", "--no-progress")
+    return champion
+
+
+def make_gallery(args: argparse.Namespace) -> None:
+    run(sys.executable, "examples/render_gallery.py", demo_champion(args), "--out", DOCS / "img", "--force")
+
+
+def make_random_episode(args: argparse.Namespace) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        run(sys.executable, "examples/random_episode.py", "--environment", "2", "--steps", "600", "--seed", "0",
+            "--out", Path(tmp) / "random_episode.gif", "--png", DOCS / "random_episode.png")
+
+
+def make_evolved_team(args: argparse.Namespace) -> None:
+    run(*cli("gathering-replay"), args.evidence / "S2-seed1" / "champion.json", "--seed", "3", "--steps", "2000",
+        "--png", DOCS / "evolved_team.png", "--out", Path(tempfile.mkdtemp()) / "team.gif")
+
+
+def make_evidence(args: argparse.Namespace) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        report = Path(tmp) / "report"
+        run(*cli("gathering-analyze"), *(args.evidence / r for r in EVIDENCE_RUNS), "--reevaluate", "20",
+            "--out", report)
+        for produced in sorted(report.iterdir()):  # the figures with the report they belong to
+            shutil.copy2(produced, DOCS / "evidence" / produced.name)
+
+
+LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
+LEARNING_RUN_FILES = ("stats.png", "stats.jsonl", "stats.csv", "experiment.json", "champion.json")
+
+
+def make_learning(args: argparse.Namespace) -> None:
+    """The learning benchmark's figure and small files, from ``make bench-learning``'s folder
+    (``--learning DIR``; the benchmark itself takes about an hour)."""
+    target = DOCS / "evidence" / "learning"
+    for name in LEARNING_FILES:
+        shutil.copy2(args.learning / name, target / name)
+    for run_name in ("S1", "M1"):
+        for name in LEARNING_RUN_FILES:
+            shutil.copy2(args.learning / run_name / name, target / run_name / name)
+
+
+def make_rl(args: argparse.Namespace) -> None:
+    champion = demo_champion(args)
+    made = ROOT / "out" / "rl-figures"  # rl_figures.py writes only into its own folder, never docs/rl
+    run(sys.executable, "examples/rl_figures.py", "--runs", args.rl, "--champion", champion.parent, "--out", made)
+    for picture in RL_FIGURES:
+        shutil.copy2(made / picture, DOCS / "rl" / picture)
+    for picture, run_dir in RL_CURVES.items():
+        shutil.copy2(args.rl / run_dir / "curve.png", DOCS / "rl" / picture)
+
+
+STEPS: dict[str, Step] = {
+    "gallery": Step(tuple(f"img/render-{name}.png" for name in GALLERY), None, make_gallery),
+    "random-episode": Step(("random_episode.png",), None, make_random_episode),
+    "evolved-team": Step(("evolved_team.png",), "evidence", make_evolved_team),
+    "evidence": Step(tuple(f"evidence/{f}" for f in EVIDENCE_FIGURES), "evidence", make_evidence),
+    "rl": Step(tuple(f"rl/{f}" for f in (*RL_FIGURES, *RL_CURVES)), "rl", make_rl),
+    "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
+                      "evidence/learning/M1/stats.png"), "learning", make_learning),
+}
+
+
+def outputs() -> set[str]:
+    """Every picture the steps make, relative to docs/."""
+    return {path for step in STEPS.values() for path in step.outputs}
+
+
+def pictures_in_docs(docs: Path = DOCS) -> set[str]:
+    """Every picture file under ``docs``, relative to it."""
+    return {p.relative_to(docs).as_posix() for p in docs.rglob("*") if p.suffix.lower() in PICTURE_SUFFIXES}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--only", default=None,
+                        help=f"comma-separated steps to run (default: all whose inputs are given): {', '.join(STEPS)}")
+    parser.add_argument("--champion", type=Path, default=None,
+                        help="champion.json for the gallery (default: make demo's, out/quick/champion.json)")
+    parser.add_argument("--learning", type=Path, default=None,
+                        help="folder of make bench-learning (runs/bench-learning): the learning benchmark's figures")
+    parser.add_argument("--evidence", type=Path, default=None,
+                        help="folder of the evidence runs (S2-seed1 ... M2-seed2; docs/evidence/README.md)")
+    parser.add_argument("--rl", type=Path, default=None, help="folder of the PPO runs of docs/rl/README.md")
+    args = parser.parse_args(argv)
+    chosen = list(STEPS) if args.only is None else [s.strip() for s in args.only.split(",") if s.strip()]
+    unknown = [s for s in chosen if s not in STEPS]
+    if unknown:
+        parser.error(f"--only {args.only}: unknown step {unknown[0]!r}; allowed: {', '.join(STEPS)}")
+    for name in chosen:
+        step = STEPS[name]
+        if step.needs and getattr(args, step.needs) is None:
+            print(f"skipped {name} ({len(step.outputs)} pictures): needs --{step.needs} DIR")
+            continue
+        step.make(args)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,38 @@
+"""Every picture of docs/ is made by examples/docs_images.py (make docs-images), so none can go
+stale unnoticed: the script's list of outputs and the pictures in docs/ are the same set.
+Checked without running the script (its steps take minutes to hours)."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def load(name: str):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "examples" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules.setdefault(name, module)  # dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_every_picture_in_docs_is_made_by_the_script_and_nothing_else():
+    images = load("docs_images")
+    in_docs = images.pictures_in_docs()
+    made = images.outputs()
+    assert sorted(in_docs - made) == [], "pictures in docs/ that no step of docs_images.py makes"
+    assert sorted(made - in_docs) == [], "outputs of docs_images.py missing from docs/"
+
+
+def test_the_gallery_step_lists_what_render_gallery_draws():
+    assert load("docs_images").GALLERY == load("render_gallery").NAMES
+
+
+def test_pictures_in_docs_finds_nested_pictures(tmp_path):
+    (tmp_path / "a" / "b").mkdir(parents=True)
+    for name in ("x.png", "a/y.gif", "a/b/z.PNG", "a/notes.md"):
+        (tmp_path / name).write_text("")
+    assert load("docs_images").pictures_in_docs(tmp_path) == {"x.png", "a/y.gif", "a/b/z.PNG"}
