@@ -55,7 +55,7 @@ RL_FIGURES = tuple(f"compare-env{e}-{s}.png" for e in (1, 2) for s in (2000, 100
 @dataclass(frozen=True)
 class Step:
     outputs: tuple[str, ...]        # pictures, relative to docs/
-    needs: str | None               # None, "evidence", "rl", "marl" or "learning"
+    needs: str | None               # None or the option naming its input folder
     make: Callable[[argparse.Namespace], None]
 
 
@@ -114,6 +114,17 @@ def make_marl(args: argparse.Namespace) -> None:
     run(sys.executable, "examples/marl_figures.py", "--runs", args.marl, "--out", DOCS / "rl")
 
 
+ORIGINAL_S1_FILES = ("stats.png", "stats.jsonl", "stats.csv", "experiment.json", "champion.json")
+
+
+def make_original_s1(args: argparse.Namespace) -> None:
+    """The original-protocol S1 run's figure and small files (``--original-s1 DIR``: its run
+    directory, ``gathering-evolve S1-original``; hours of CPU)."""
+    for name in ORIGINAL_S1_FILES:
+        if (args.original_s1 / name).exists():
+            shutil.copy2(args.original_s1 / name, DOCS / "evidence" / "original-S1" / name)
+
+
 LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
 LEARNING_RUN_FILES = ("stats.png", "stats.jsonl", "stats.csv", "experiment.json", "champion.json")
 
@@ -146,6 +157,7 @@ STEPS: dict[str, Step] = {
     "evidence": Step(tuple(f"evidence/{f}" for f in EVIDENCE_FIGURES), "evidence", make_evidence),
     "rl": Step(tuple(f"rl/{f}" for f in (*RL_FIGURES, *RL_CURVES)), "rl", make_rl),
     "marl": Step(("rl/curves-marl-env1.png",), "marl", make_marl),
+    "original-s1": Step(("evidence/original-S1/stats.png",), "original_s1", make_original_s1),
     "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
                       "evidence/learning/M1/stats.png"), "learning", make_learning),
 }
@@ -167,6 +179,8 @@ def main(argv: list[str] | None = None) -> int:
                         help=f"comma-separated steps to run (default: all whose inputs are given): {', '.join(STEPS)}")
     parser.add_argument("--champion", type=Path, default=None,
                         help="champion.json for the gallery (default: make demo's, out/quick/champion.json)")
+    parser.add_argument("--original-s1", type=Path, default=None,
+                        help="run directory of gathering-evolve S1-original: the original protocol's evidence")
     parser.add_argument("--marl", type=Path, default=None,
                         help="folder of the BenchMARL runs (examples/benchmarl_run.py): the IPPO/MAPPO figures")
     parser.add_argument("--learning", type=Path, default=None,
@@ -182,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
     for name in chosen:
         step = STEPS[name]
         if step.needs and getattr(args, step.needs) is None:
-            print(f"skipped {name} ({len(step.outputs)} pictures): needs --{step.needs} DIR")
+            print(f"skipped {name} ({len(step.outputs)} pictures): needs --{step.needs.replace("_", "-")} DIR")
             continue
         step.make(args)
     return 0
