@@ -196,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
     for name in chosen:
         step = STEPS[name]
         if step.needs and getattr(args, step.needs) is None:
-            print(f"skipped {name} ({len(step.outputs)} pictures): needs --{step.needs.replace("_", "-")} DIR")
+            print(f"skipped {name} ({len(step.outputs)} pictures): needs --{step.needs.replace('_', '-')} DIR")
             continue
         step.make(args)
     return 0
