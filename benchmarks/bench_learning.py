@@ -181,11 +181,14 @@ def markdown(data: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main(argv: list[str] | None = None) -> int:
+def _main(argv: list[str] | None = None) -> int:
+    from evolution.guard import UsageError
+
     args = parse(argv)
+    if args.out.exists() and not args.out.is_dir():
+        raise UsageError(f"{args.out}: is a file; allowed: a folder for the two runs and the results")
     if not args.resume and args.out.exists() and any(args.out.iterdir()):
-        print(f"error: {args.out}: not empty; allowed: a new folder, or --resume to continue its runs", file=sys.stderr)
-        return 2
+        raise UsageError(f"{args.out}: not empty; allowed: a new folder, or --resume to continue its runs")
     budget = {k: getattr(args, k) for k in ("population", "trials", "steps", "generations", "seed", "heldout",
                                             "heldout_steps", "workers")}
     print("budget per experiment: " + ", ".join(f"{k} {v}" for k, v in budget.items()), flush=True)
@@ -212,6 +215,14 @@ def main(argv: list[str] | None = None) -> int:
     figure(data, args.out / "learning.png")
     print(f"wrote {args.out / 'learning.json'}, learning.md, learning.png")
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """One line and exit status 2 for bad input (the commands' guard), also from the runs (a
+    second copy on the same folder meets the run lock)."""
+    from evolution.guard import command
+
+    return command(_main)(argv)
 
 
 if __name__ == "__main__":

@@ -99,6 +99,11 @@ def figure4(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="best")
     path = out / "figure4_fronts.png"
+    return _save(fig, path)
+
+
+def _save(fig: plt.Figure, path: Path) -> Path:
+    """Write a figure (the error names the file) and free it."""
     with writing(path):
         fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -122,10 +127,7 @@ def figure5(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7)
     path = out / "figure5_simplicity.png"
-    with writing(path):
-        fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def figure6(analysis: Analysis, out: Path) -> Path:
@@ -145,10 +147,7 @@ def figure6(analysis: Analysis, out: Path) -> Path:
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7)
     path = out / "figure6_points.png"
-    with writing(path):
-        fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 #: Every file ``write_report`` writes: the output folder may hold these (an earlier report,
