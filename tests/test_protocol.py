@@ -388,3 +388,49 @@ def test_spawn_counts_reach_the_offspring_places_exactly():
     repro = NEATReproduction.__new__(NEATReproduction)
     assert repro._exact_spawn([3, 2, 1, 1, 1, 1, 1], 7, 1) == [1] * 7
     assert repro._exact_spawn([1, 1, 1], 6, 1) == [2, 2, 2]
+
+
+def _population_of_one_species(size, body):
+    import neat
+
+    from evolution.run.neat_setup import make_neat_config
+
+    exp = load_experiment(None, {"population": size, **body})
+    config = make_neat_config(exp)
+    population = neat.Population(config, seed=3)
+    scores = {key: float((key * 37) % 101) for key in population.population}   # distinct
+    for key, g in population.population.items():
+        g.fitness = scores[key]
+    return config, population, scores
+
+
+def test_encogs_selection_keeps_the_best_fifth_of_a_species_and_the_ratchet_scores_none_of_them():
+    """Encog's SO selection (speciation = "original"): generation 0 is one species of 20; the
+    ratchet carries the best, the species' best 20 % (4, the best among them) survive too, none
+    of them re-scored, and 16 offspring fill the population; the leader is the species' best."""
+    config, population, scores = _population_of_one_species(20, {"speciation": "original", "elitism": "ratchet"})
+    assert len(population.species.species) == 1
+    repro = population.reproduction
+    new = repro.reproduce(config, population.species, 20, 0)
+    ranked = sorted(scores, key=lambda k: (scores[k], k), reverse=True)
+    assert len(new) == 20
+    assert repro.carried == set(ranked[:4])             # the best + the next three of the top 4
+    assert set(new) & set(scores) == set(ranked[:4])    # no other genome of generation 0 survives
+    (species,) = population.species.species.values()
+    assert species.representative.key == ranked[0]      # the leader of the next speciation
+    assert config.stagnation_config.max_stagnation == 16
+
+
+def test_encogs_selection_without_the_ratchet_keeps_elites_that_are_scored_again():
+    config, population, scores = _population_of_one_species(20, {"speciation": "original"})
+    repro = population.reproduction
+    new = repro.reproduce(config, population.species, 20, 0)
+    ranked = sorted(scores, key=lambda k: (scores[k], k), reverse=True)
+    assert len(new) == 20 and not repro.carried
+    assert set(new) & set(scores) == set(ranked[:4])    # 20 % of 20 survive as they are
+
+
+def test_the_paper_protocols_species_keep_neat_pythons_selection():
+    config, population, _ = _population_of_one_species(20, {})
+    assert not config.species_set_config.leaders
+    assert config.stagnation_config.max_stagnation == 20

@@ -157,18 +157,64 @@ def test_original_rule_moves_by_a_hundredth_at_its_bounds(tmp_path):
             cfg.min_species) == ("original", 1.0, 0.01, 40, 2)
     population = neat.Population(config, seed=2)
     species = population.species
-    assert species.history[-1][1] == 1.0
-    n = len(species.species)
-    # raw-weight distances of new CPPNs are large: far more than 40 species, so +0.01 next time
-    assert n > 40
+    # Encog puts generation 0 into one species
+    assert len(species.species) == 1 and species.history[-1][1] == 1.0
+    # one survivor is fewer than 2: -0.01 before assigning; raw-weight distances of new CPPNs
+    # to the leader are large, so far more than 40 species form
     species.speciate(config, population.population, 1)
-    assert species.history[-1][1] == pytest.approx(1.01)
-    species.species = dict(list(species.species.items())[:1])   # one survivor: fewer than 2
-    species.speciate(config, population.population, 2)
+    assert species.history[-1][1] == pytest.approx(0.99)
+    assert len(species.species) > 40
+    species.speciate(config, population.population, 2)      # more than 40 survived: +0.01
     assert species.history[-1][1] == pytest.approx(1.0)
     mo = make_neat_config(load_experiment(None, {"population": 150, "speciation": "original",
                                                  "objectives": ["task", "morphology"]}))
     assert mo.species_set_config.max_species == 150
+
+
+def test_original_spawn_by_hand():
+    from evolution.reproduction.breeding import original_spawn
+
+    # shares 10, 0, 5, 0.2 of 15.2 over 9 places: 5.92 -> 6, 0, 2.96 -> 3, 0.12 -> 0 (dies)
+    assert original_spawn([10, 0, 5, 0.2], [10, 0, 15, 0.2], 0, 9) == [6, 0, 3, 0]
+    # the best genome's species keeps a place when its share rounds to 0 (the surplus comes off
+    # the other species, which ranks below it by best score)
+    assert original_spawn([50, 0.1], [50, 60], 1, 9) == [8, 1]
+    # a surplus comes off the species with the lowest best scores (2 + 2 + 2 + 2 > 6)
+    assert original_spawn([1, 1, 1, 1], [4, 3, 2, 1], 0, 6) == [2, 2, 2, 0]
+    assert original_spawn([1, 1, 1, 1], [1, 2, 3, 4], 3, 6) == [0, 2, 2, 2]
+    # a shortfall goes to the species with the best score; all shares 0: round(places / n) each
+    assert original_spawn([1, 1, 1], [1, 5, 2], 1, 4) == [1, 2, 1]
+    assert original_spawn([0.0] * 118, [0.0] * 118, 0, 149) == [32] + [1] * 117
+
+
+def test_original_species_of_leaders_by_hand(tmp_path):
+    """First species (oldest first) whose leader is within the threshold, not the nearest; a
+    species whose leader is gone is disbanded; a genome far from every leader founds one."""
+    config = make_neat_config(load_experiment(None, {"population": 6, "speciation": "original"}))
+    assert config.species_set_config.leaders
+    species = GatheringSpeciesSet(config.species_set_config, neat.reporting.ReporterSet())
+
+    def genome(key, w):
+        g = genome_with([(1, w)])
+        g.key = key
+        return g
+
+    # leaders at 0.0 (species 1), 2.0 (species 2) and 4.0 (species 3); distance 0.4 * |dw|
+    leaders = {1: genome(1, 0.0), 2: genome(2, 2.0), 3: genome(3, 4.0)}
+    for sid, g in leaders.items():
+        species.species[sid] = neat.species.Species(sid, 0)
+        species.species[sid].update(g, {g.key: g})
+    species.indexer = iter(range(4, 100))
+    species.history.append((0, 1.0, 3))
+    # genome 3 (species 3's leader) is not in the new population: species 3 is disbanded
+    population = {1: leaders[1], 2: leaders[2], 10: genome(10, 1.5), 11: genome(11, 2.2), 12: genome(12, 4.0),
+                  13: genome(13, 9.0)}
+    species.speciate(config, population, 1)
+    members = {sid: sorted(s.members) for sid, s in species.species.items()}
+    # 10 is 0.6 from leader 1 and 0.2 from leader 2: the first within 1.0 wins (species 1);
+    # 11: 0.88 from 1, joins 1; 12 (where leader 3 was): 1.6 and 0.8 -> species 2; 13 founds species 4
+    assert members == {1: [1, 10, 11], 2: [2, 12], 4: [13]}
+    assert species.species[4].representative.key == 13
 
 
 def test_run_statistics_record_threshold_and_species(tmp_path):

@@ -208,6 +208,52 @@ def breed(candidates: list[int], genomes: dict[int, Any], score: dict[int, float
     return children
 
 
+#: Encog's species elitism in the original's single-objective runs (``SingleObjectiveEA``,
+#: ``setEliteRate(0.2)``): the best 20 % of every species of more than 5 genomes survive as they are.
+ORIGINAL_ELITE_RATE, ORIGINAL_ELITE_MIN_MEMBERS = 0.2, 5
+#: Encog's stagnation in its speciation: a species is removed after more than 15 generations
+#: without improvement (neat-python's ``max_stagnation`` counts to 16), except the best species.
+ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM = 16, 1
+
+
+def java_round(x: float) -> int:
+    """Java's ``Math.round`` (halves round up), as Encog rounds offspring shares."""
+    return int(math.floor(x + 0.5))
+
+
+def original_spawn(means: list[float], bests: list[float], best: int, places: int) -> list[int]:
+    """Encog's offspring counts per species (``ThresholdSpeciation``), 0 for a species that dies.
+
+    ``means``: each species' mean score (its share; negative counts as 0), ``bests``: its best
+    score, ``best``: index of the species holding the best genome, ``places``: offspring to
+    place. Each species gets ``round(share / total * places)``; a species whose count rounds to 0
+    dies (not the best one, which gets at least 1); with every share 0 each gets
+    ``round(places / n)``. Then *level off*: species ordered by best score, the first gets at
+    least 1; a surplus is taken from the last species backwards (never the first), a shortfall
+    goes to the first.
+    """
+    n = len(means)
+    shares = [max(0.0, m) for m in means]
+    total = sum(shares)
+    if total < 1e-7:  # Encog.DEFAULT_DOUBLE_EQUAL
+        counts = [java_round(places / n)] * n
+    else:
+        counts = [java_round(share / total * places) for share in shares]
+        counts[best] = max(counts[best], 1)
+    order = sorted((i for i in range(n) if counts[i] > 0), key=lambda i: (-bests[i], i))
+    counts[order[0]] = max(counts[order[0]], 1)
+    diff = places - sum(counts)
+    if diff < 0:
+        for i in reversed(order[1:]):
+            take = min(counts[i], -diff)
+            counts[i] -= take
+            diff += take
+            if diff == 0:
+                break
+    counts[order[0]] += max(diff, 0)
+    return counts
+
+
 class NEATReproduction(neat.DefaultReproduction):
     """neat-python's NEAT selection (fitness sharing, stagnation, elitism) with ``breed``.
 
@@ -221,6 +267,13 @@ class NEATReproduction(neat.DefaultReproduction):
     population as it is, with its fitness, and ``carried`` names it so that the trainer does
     not evaluate it again; no other genome survives (the per-species ``elitism`` is not used)
     and the other ``pop_size - 1`` genomes are offspring.
+
+    **Encog's selection** (with the species set's Encog ``leaders``: ``speciation =
+    "original"`` in SO): offspring counts by ``original_spawn`` from each species' mean
+    fitness (no damping by the previous size, no minimum per species); the best 20 % of
+    every species of more than 5 genomes survive unchanged (``ORIGINAL_ELITE_RATE``; carried
+    unscored with the ratchet, as Encog does not score them again) and count towards its
+    offspring; each species' best genome becomes its leader for the next speciation.
     """
 
     def __init__(self, config: Any, reporters: Any, stagnation: Any) -> None:
@@ -273,8 +326,10 @@ class NEATReproduction(neat.DefaultReproduction):
         for s in remaining:  # neat-python's adjusted fitness
             s.adjusted_fitness = (mean([m.fitness for m in s.members.values()]) - low) / span
         cfg = self.reproduction_config
-        elitism = 0 if ratchet else cfg.elitism
         offspring = pop_size - 1 if ratchet else pop_size
+        if getattr(species.species_set_config, "leaders", False):
+            return self._reproduce_original(config, species, remaining, offspring, ratchet)
+        elitism = 0 if ratchet else cfg.elitism
         min_size = max(cfg.min_species_size, elitism)
         if len(remaining) * min_size > offspring:
             # more species than offspring places (the original's speciation can form many): the
@@ -303,5 +358,40 @@ class NEATReproduction(neat.DefaultReproduction):
             n -= len(elites)
             score = {k: float(members[k].fitness) for k in ranked}
             new_population.update(breed(ranked, members, score, n, config, lambda: next(self.genome_indexer),
+                                        self.ancestors))
+        return new_population
+
+    def _reproduce_original(self, config: Any, species: Any, remaining: list[Any], offspring: int,
+                            ratchet: bool) -> dict[int, Any]:
+        """Encog's selection (see the class docstring) over the non-stagnant species."""
+        ranked = {s.key: sorted(s.members, key=lambda k: (s.members[k].fitness, k), reverse=True) for s in remaining}
+        fitness = {k: g.fitness for s in remaining for k, g in s.members.items()}
+        best_key = self.best.key if ratchet and self.best is not None else max(fitness, key=lambda k: (fitness[k], k))
+        best_index = next((i for i, s in enumerate(remaining) if best_key in s.members), 0)
+        counts = original_spawn([mean([m.fitness for m in s.members.values()]) for s in remaining],
+                                [s.members[ranked[s.key][0]].fitness for s in remaining], best_index, offspring)
+        new_population: dict[int, Any] = {}
+        if ratchet:
+            new_population[self.best.key] = self.best  # as it is: not evaluated again
+            self.carried = {self.best.key}
+        species.species = {}
+        for n, s in zip(counts, remaining):
+            if n <= 0:
+                continue  # the species dies out
+            members = dict(s.members)
+            order = ranked[s.key]
+            s.members = {}
+            s.representative = members[order[0]]  # the leader of the next speciation
+            species.species[s.key] = s
+            if len(order) > ORIGINAL_ELITE_MIN_MEMBERS:
+                for k in order[:min(n, int(len(order) * ORIGINAL_ELITE_RATE))]:
+                    if ratchet and k == self.best.key:
+                        continue  # already carried (Encog skips the old best without counting it)
+                    new_population[k] = members[k]
+                    n -= 1
+                    if ratchet:
+                        self.carried.add(k)
+            score = {k: float(members[k].fitness) for k in order}
+            new_population.update(breed(order, members, score, n, config, lambda: next(self.genome_indexer),
                                         self.ancestors))
         return new_population

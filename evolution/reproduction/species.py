@@ -23,7 +23,13 @@ speciation, by ``species_mode`` in its config section ``[GatheringSpeciesSet]``:
   sensor genes (NEAT-M) their sensor term; before genomes are assigned, the threshold moves by
   ``threshold_step`` (0.01, additive): up when the previous generation had more than
   ``max_species`` species (40 in SO, the population in MO), down when fewer than
-  ``min_species`` (2); it starts at ``compatibility_threshold`` (1.0).
+  ``min_species`` (2); it starts at ``compatibility_threshold`` (1.0). In single-objective runs
+  species are also Encog's (``leaders``, set by ``use_original_rule``): generation 0 is one
+  species; a species is represented by its *leader* (its best genome, which
+  ``NEATReproduction`` names after each evaluation) and is disbanded when its leader is not in
+  the new population; a genome joins the first species, oldest first, whose leader is within
+  the threshold (``<=``), else it founds a new one. (neat-python instead keeps every species
+  that finds a closest genome and puts a genome in the nearest species.)
 * ``fixed``: neat-python's behaviour (the threshold never moves).
 
 The threshold and the species count of every generation are in ``history`` (and the run's
@@ -91,6 +97,7 @@ def use_original_rule(config: SpeciesSetConfig, multi_objective: bool, populatio
     config.threshold_step = ORIGINAL_RULE["threshold_step"]
     config.min_species = ORIGINAL_RULE["min_species"]
     config.max_species = population if multi_objective else ORIGINAL_RULE["max_species_so"]
+    config.leaders = not multi_objective
 
 
 def adapted_threshold(threshold: float, count: int, target: int, step: float, minimum: float,
@@ -135,6 +142,7 @@ class SpeciesSetConfig(DefaultClassConfig):
             ConfigParameter("max_species", int, 40),
             ConfigParameter("min_species", int, 2),
         ])
+        self.leaders = False  # Encog's species of leaders (SO, original mode): set by use_original_rule
         problems = []
         if self.species_mode not in MODES:
             problems.append(("species_mode", self.species_mode, " / ".join(MODES)))
@@ -169,6 +177,11 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
 
     def speciate(self, config: Any, population: dict[int, Any], generation: int) -> None:
         cfg = self.species_set_config
+        leaders = cfg.species_mode == "original" and getattr(cfg, "leaders", False)
+        if leaders:
+            # Encog's resetSpecies: a species whose leader did not survive is disbanded
+            for sid in [sid for sid, s in self.species.items() if s.representative.key not in population]:
+                del self.species[sid]
         if cfg.species_mode == "original" and self.history:
             # Encog decides before assigning, from the number of species that survived
             survivors = len(self.species)
@@ -178,7 +191,10 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
                 self.threshold = max(cfg.threshold_min, self.threshold - cfg.threshold_step)
         used = self.threshold
         before = set(self.species)
-        self._speciate_at(config, population, generation, used)
+        if leaders:
+            self._speciate_leaders(config, population, generation, used)
+        else:
+            self._speciate_at(config, population, generation, used)
         count = len(self.species)
         self.history.append((int(generation), used, count))
         if cfg.species_mode == "adaptive":
@@ -233,6 +249,37 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
         # species that found no member are gone (neat-python drops them the same way)
         for sid in [sid for sid in self.species if sid not in representatives]:
             del self.species[sid]
+
+    def _speciate_leaders(self, config: Any, population: dict[int, Any], generation: int, threshold: float) -> None:
+        """Encog's assignment (see the module docstring): leaders stay in their species; every other
+        genome, in key order, joins the first species (oldest first, founded ones included) whose
+        leader is within ``threshold``, or founds one. Generation 0 (no species yet) is one species."""
+        order = sorted(self.species)
+        leader = {sid: self.species[sid].representative.key for sid in order}
+        members = {sid: [leader[sid]] for sid in order}
+        others = [gid for gid in sorted(population) if gid not in set(leader.values())]
+        if not order and others:
+            sid = next(self.indexer)
+            order, leader, members = [sid], {sid: others[0]}, {sid: list(others)}
+            others = []
+        for gid in others:
+            genome = population[gid]
+            for sid in order:
+                if self._original(population[leader[sid]], genome, config) <= threshold:
+                    members[sid].append(gid)
+                    break
+            else:
+                sid = next(self.indexer)
+                order.append(sid)
+                leader[sid], members[sid] = gid, [gid]
+        self.genome_to_species = {}
+        for sid in order:
+            species = self.species.get(sid)
+            if species is None:
+                species = self.species[sid] = neat.species.Species(sid, generation)
+            for gid in members[sid]:
+                self.genome_to_species[gid] = sid
+            species.update(population[leader[sid]], {gid: population[gid] for gid in members[sid]})
 
     @staticmethod
     def _original(a: Any, b: Any, config: Any) -> float:

@@ -62,6 +62,11 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
         species.species_mode = experiment.speciation
         if experiment.speciation == "original":
             use_original_rule(species, experiment.multi_objective, experiment.population)
+            if not experiment.multi_objective:  # Encog's stagnation (NEATReproduction's Encog selection)
+                from evolution.reproduction.breeding import ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM
+
+                config.stagnation_config.max_stagnation = ORIGINAL_MAX_STAGNATION
+                config.stagnation_config.species_elitism = ORIGINAL_SPECIES_ELITISM
     if species.species_mode == "adaptive":
         try:
             target_count(species.target_species, experiment.population)

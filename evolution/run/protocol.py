@@ -12,11 +12,15 @@ key                           paper (default)     original
 ``[experiment] layout``       ``"per_trial"``     ``"per_run"``: one layout for every trial of
                                                   every genome of every generation (the run's
                                                   seed); the trials are then one episode, run once
-``[experiment] elitism``      ``"species"``       ``"ratchet"``: only the best-ever genome is
+``[experiment] elitism``      ``"species"``       ``"ratchet"``: the best-ever genome is
                                                   carried over, unchanged and never re-scored
+                                                  (with Encog's selection its species elites too)
 ``[experiment] complexity``   ``"paper"``         ``"original"``: eq. 2 as the code computed it
 ``[experiment] speciation``   (the neat config's  ``"original"``: Encog's distance and threshold
-                              ``species_mode``)   rule (``evolution.reproduction.species``)
+                              ``species_mode``)   rule (``evolution.reproduction.species``); in SO
+                                                  also Encog's species of leaders, offspring
+                                                  shares, 20 % species elites and stagnation 15
+                                                  (``evolution.reproduction.breeding``)
 ``[environment] zone_depth``  8                   4 (zone 20 x 4)
 ``[environment] pickup_box``  ``"front"``         ``"centre"``, 0.1 forward x 0.2 across
 ``[environment] ir_response`` ``"linear"``        ``"gamma"`` (the Khepera-like curve)

@@ -60,8 +60,12 @@ def protocol_notes(exp: Experiment) -> list[str]:
         notes.append(f"{exp.name}: one layout for the whole run (layout = per_run): its {exp.trials} trials would be "
                      "the same episode in this deterministic simulator, so each genome runs it once")
     if exp.elitism == "ratchet" and not exp.multi_objective:
-        notes.append(f"{exp.name}: ratchet (elitism = ratchet): the best-ever genome is carried over with its "
-                     "stored score and not evaluated again; only offspring are scored")
+        carried = "the best-ever genome is carried over"
+        if exp.speciation == "original":
+            carried = ("the best-ever genome and Encog's species elites (the best 20 % of each species of more "
+                       "than 5) are carried over")
+        notes.append(f"{exp.name}: ratchet (elitism = ratchet): {carried} with their stored scores and not "
+                     "evaluated again; only offspring are scored")
     return notes
 
 
