@@ -1,25 +1,29 @@
 """The IPPO / MAPPO figures of docs/rl/README.md: held-out seeds paired against wander, PPO and the champion.
 
-    python examples/marl_figures.py --runs out/marl --out docs/rl
+    python examples/marl_figures.py --runs out/marl --out docs/rl     # references from docs/rl/marl-rows.json
+    python examples/marl_figures.py --runs out/marl --rows out/rl-figures/rows.json --out docs/rl   # new references
 
 ``--runs`` holds BenchMARL runs of ``examples/benchmarl_run.py`` (folders with ``policy.pt``,
 ``curve.csv``, ``run.json``). Every run's policy plays the paired comparison's 40 held-out seeds
 of environment 1 (20 000..20 039, 2 000 steps; the seeds of ``paired-env1-2000.md``) with
-deterministic and sampled actions; ``wander``, the quick champion and the PPO runs are read from
-``rows.json`` (rl_figures.py's per-seed cache: the same seeds), after replaying ``wander`` on a
-few seeds to check the episodes are still the ones stored. Writes into ``--out``:
+deterministic and sampled actions; ``random``, ``wander``, the quick champion and the PPO run are
+read from ``--rows`` (rl_figures.py's per-seed cache ``rows.json`` on the same seeds, or this
+script's own ``marl-rows.json``, which keeps them), after replaying ``wander`` on a few seeds to
+check the episodes are still the ones stored. Writes into ``--out``:
 
 * ``paired-marl-env1-2000.md``: ft mean ± standard error per policy; paired differences (mean ±
   SE, Wilcoxon signed-rank p, two-sided) against wander, the champion and shaped PPO;
 * ``curves-marl-env1.png``: ft of every training episode (smoothed) vs environment steps;
 * ``budgets-marl.md``: environment steps, minutes and environment steps/s of every run;
-* ``curve-<run>.csv``: each run's training curve; ``marl-rows.json``: the per-seed cache.
+* ``curve-<run>.csv``: each run's training curve; ``marl-rows.json``: the rows of the table (the
+  BenchMARL policies' keyed by their file's content, and the reference rows).
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import hashlib
 import json
 import shutil
 from pathlib import Path
@@ -43,19 +47,22 @@ def stored_rows(path: Path) -> dict[str, list[float]]:
     return {row["policy"]: row["ft"] for key, row in json.loads(path.read_text()).items() if key.endswith(suffix)}
 
 
-def evaluate(spec: str, cache: dict, cache_path: Path) -> list[float]:
+def evaluate(spec: str, cache: dict, cache_path: Path, used: set[str]) -> list[float]:
     """ft on every seed, all 40 worlds stepped together (``VectorSimulation``: each world's episode is
     the env's for its seed; deterministic actions give exactly gathering-compare's episodes, sampled
-    ones draw their noise from one torch generator seeded with the first seed)."""
+    ones draw their noise from one torch generator seeded with the first seed). The cache is keyed by
+    the policy file's content; ``used`` collects the keys of this run."""
     import torch
 
     from evolution.policies.marl import read_policy_file, worlds_actor
     from gathering_env import Morphology
     from gathering_env.vector import VectorSimulation
 
-    key = f"{spec}|env1|{STEPS}|seeds{SEEDS[0]}-{SEEDS[-1]}"
+    kind, _, path = spec.partition(":")
+    digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]  # the policy file's content, not its place
+    key = f"{kind}:{digest}|env1|{STEPS}|seeds{SEEDS[0]}-{SEEDS[-1]}"
+    used.add(key)
     if key not in cache:
-        kind, _, path = spec.partition(":")
         data = read_policy_file(path)
         act = worlds_actor(data, sample=kind == "benchmarl-sample", path=path)
         sims = VectorSimulation(len(SEEDS), environment=1, max_cycles=STEPS, num_robots=20,
@@ -120,7 +127,9 @@ def plot_curves(curves: dict[str, tuple[np.ndarray, np.ndarray]], wander: float,
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--runs", type=Path, default=Path("out/marl"))
-    parser.add_argument("--rows", type=Path, default=Path("docs/rl/rows.json"), help="rl_figures.py's per-seed cache")
+    parser.add_argument("--rows", type=Path, default=Path("docs/rl/marl-rows.json"),
+                        help="per-seed rows of wander, random, the champion and PPO: rl_figures.py's cache (rows.json) "
+                             "or this script's own marl-rows.json, which keeps the rows it used")
     parser.add_argument("--out", type=Path, default=Path("docs/rl"))
     args = parser.parse_args()
     stored = stored_rows(args.rows)
@@ -132,11 +141,11 @@ def main() -> None:
     cache_path = args.out / "marl-rows.json"
     cache = json.loads(cache_path.read_text()) if cache_path.exists() else {}
     by_name = {name: np.array(stored[name]) for name in ("random", *REFERENCES.values()) if name in stored}
-    curves, budgets = {}, []
+    curves, budgets, used = {}, [], set()
     runs = sorted(p for p in args.runs.iterdir() if (p / "policy.pt").exists())
     for run in runs:
         for kind in ("benchmarl-sample", "benchmarl"):
-            ft = evaluate(f"{kind}:{run / 'policy.pt'}", cache, cache_path)
+            ft = evaluate(f"{kind}:{run / 'policy.pt'}", cache, cache_path, used)
             by_name[f"{kind}:{run.name}"] = np.array(ft)
         alone = [run_episode(env, make_policy(f"benchmarl:{run / 'policy.pt'}"), s)["ft"] for s in SEEDS[:2]]
         if alone != ft[:2]:                   # the batched evaluation must be gathering-compare's episodes
@@ -149,6 +158,13 @@ def main() -> None:
     for extra in sorted(args.runs.glob("*-partial/curve.csv")):      # runs stopped early: curve only
         curves[extra.parent.name] = read_curve(extra)
         shutil.copy(extra, args.out / f"curve-{extra.parent.name}.csv")
+    # this table's rows only: the BenchMARL policies' and the reference rows read from --rows, so the
+    # file alone regenerates the table (--rows docs/rl/marl-rows.json, the default)
+    kept = {k: v for k, v in cache.items() if k in used}
+    for name in ("random", *REFERENCES.values()):
+        if name in stored:
+            kept[f"reference:{name}|env1|{STEPS}|seeds{SEEDS[0]}-{SEEDS[-1]}"] = {"policy": name, "ft": stored[name]}
+    cache_path.write_text(json.dumps(kept, indent=1))
     (args.out / "paired-marl-env1-2000.md").write_text(paired_table(by_name))
     (args.out / "budgets-marl.md").write_text(
         "| run | algorithm | env steps | minutes (this machine) | env steps/s |\n|---|---|---|---|---|\n"
