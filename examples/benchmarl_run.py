@@ -133,7 +133,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--epochs", type=count, default=10, help="on-policy: passes over each batch")
     p.add_argument("--minibatch", type=count, default=128, help="on-policy: environment steps per minibatch")
     p.add_argument("--lr", type=float_arg(0.0, open_low=True), default=1e-3)
-    p.add_argument("--entropy", type=float_arg(0.0), default=0.01, help="on-policy: entropy bonus")
+    p.add_argument("--entropy", type=float_arg(0.0), default=0.003,
+                   help="on-policy: entropy bonus (default 0.003; 0.01, PPO's, made IPPO's noise grow without bound "
+                        "and 0.001 let MAPPO's collapse: docs/rl/README.md)")
     p.add_argument("--gamma", type=float_arg(0.0, 1.0, open_low=True), default=0.99)
     p.add_argument("--lmbda", type=float_arg(0.0, 1.0), default=0.95, help="on-policy: GAE lambda")
     p.add_argument("--hidden", type=count, nargs="+", default=[64, 64], help="MLP layer sizes (actor and critic)")

@@ -47,7 +47,7 @@ def stored_rows(path: Path) -> dict[str, list[float]]:
     return {row["policy"]: row["ft"] for key, row in json.loads(path.read_text()).items() if key.endswith(suffix)}
 
 
-def evaluate(spec: str, cache: dict, cache_path: Path, used: set[str]) -> list[float]:
+def evaluate(spec: str, cache: dict, cache_path: Path, used: set[str], seeds: list[int] = SEEDS) -> list[float]:
     """ft on every seed, all 40 worlds stepped together (``VectorSimulation``: each world's episode is
     the env's for its seed; deterministic actions give exactly gathering-compare's episodes, sampled
     ones draw their noise from one torch generator seeded with the first seed). The cache is keyed by
@@ -60,15 +60,15 @@ def evaluate(spec: str, cache: dict, cache_path: Path, used: set[str]) -> list[f
 
     kind, _, path = spec.partition(":")
     digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()[:16]  # the policy file's content, not its place
-    key = f"{kind}:{digest}|env1|{STEPS}|seeds{SEEDS[0]}-{SEEDS[-1]}"
+    key = f"{kind}:{digest}|env1|{STEPS}|seeds{seeds[0]}-{seeds[-1]}"
     used.add(key)
     if key not in cache:
         data = read_policy_file(path)
         act = worlds_actor(data, sample=kind == "benchmarl-sample", path=path)
-        sims = VectorSimulation(len(SEEDS), environment=1, max_cycles=STEPS, num_robots=20,
+        sims = VectorSimulation(len(seeds), environment=1, max_cycles=STEPS, num_robots=20,
                                 morphology=Morphology.coerce(data["morphology"]))
-        obs = sims.reset(SEEDS)
-        torch.manual_seed(SEEDS[0])
+        obs = sims.reset(seeds)
+        torch.manual_seed(seeds[0])
         while sims.active.any():
             obs, _, _, _ = sims.step(act(obs))
         cache[key] = {"policy": make_policy(spec).name, "ft": sims.task_performance().tolist()}
@@ -76,7 +76,7 @@ def evaluate(spec: str, cache: dict, cache_path: Path, used: set[str]) -> list[f
     return cache[key]["ft"]
 
 
-def paired_table(by_name: dict[str, np.ndarray]) -> str:
+def paired_table(by_name: dict[str, np.ndarray], seeds: list[int] = SEEDS) -> str:
     from scipy.stats import wilcoxon
 
     def versus(ft: np.ndarray, ref: np.ndarray) -> str:
@@ -86,7 +86,7 @@ def paired_table(by_name: dict[str, np.ndarray]) -> str:
         return f"{d.mean():+.2f} ± {d.std(ddof=1) / np.sqrt(len(d)):.2f} | {wilcoxon(ft, ref).pvalue:.2g}"
 
     refs = {label: name for label, name in REFERENCES.items() if name in by_name}
-    lines = [f"environment 1, 20 robots, {STEPS:,}-step episodes, {len(SEEDS)} held-out seeds ({SEEDS[0]}..{SEEDS[-1]}), "
+    lines = [f"environment 1, 20 robots, {STEPS:,}-step episodes, {len(seeds)} held-out seeds ({seeds[0]}..{seeds[-1]}), "
              "every policy on the same seeds; ± is the standard error; p: Wilcoxon signed-rank test of the per-seed "
              f"differences (two-sided); PPO = {REFERENCES['PPO']}", "",
              "| policy | ft | " + " | ".join(f"vs {label}: difference | p" for label in refs) + " |",
@@ -124,6 +124,36 @@ def plot_curves(curves: dict[str, tuple[np.ndarray, np.ndarray]], wander: float,
     plt.close(fig)
 
 
+def confirm(args: argparse.Namespace) -> None:
+    """``--confirm FIRST_SEED``: every run of ``--runs`` and the references (``--reference
+    NAME=POLICY``: evaluated here, episode by episode as gathering-compare) on 40 seeds from
+    FIRST_SEED that no setting was chosen on; writes ``paired-marl-env1-2000-seeds<FIRST>.md`` and
+    its rows (``marl-confirm-rows.json``) into ``--out``."""
+    seeds = list(range(args.confirm, args.confirm + len(SEEDS)))
+    env = parallel_env(environment=1, max_cycles=STEPS, num_robots=20)
+    cache_path = args.out / "marl-confirm-rows.json"
+    cache = json.loads(cache_path.read_text()) if cache_path.exists() else {}
+    used: set[str] = set()
+    by_name = {}
+    for ref in ["random", "wander", *args.reference]:
+        name, _, spec = ref.partition("=") if "=" in ref else (ref, "", ref)
+        key = f"reference:{name}|env1|{STEPS}|seeds{seeds[0]}-{seeds[-1]}"
+        if key not in cache:
+            policy = make_policy(spec)
+            cache[key] = {"policy": name, "ft": [run_episode(env, policy, s)["ft"] for s in seeds]}
+            cache_path.write_text(json.dumps(cache, indent=1))
+        used.add(key)
+        by_name[name] = np.array(cache[key]["ft"])
+    for run in sorted(p for p in args.runs.iterdir() if (p / "policy.pt").exists()):
+        for kind in ("benchmarl-sample", "benchmarl"):
+            by_name[f"{kind}:{run.name}"] = np.array(evaluate(f"{kind}:{run / 'policy.pt'}", cache, cache_path,
+                                                              used, seeds))
+    cache_path.write_text(json.dumps({k: v for k, v in cache.items() if k in used}, indent=1))
+    out = args.out / f"paired-marl-env1-{STEPS}-seeds{seeds[0]}.md"
+    out.write_text(paired_table(by_name, seeds))
+    print(out.read_text())
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--runs", type=Path, default=Path("out/marl"))
@@ -131,7 +161,15 @@ def main() -> None:
                         help="per-seed rows of wander, random, the champion and PPO: rl_figures.py's cache (rows.json) "
                              "or this script's own marl-rows.json, which keeps the rows it used")
     parser.add_argument("--out", type=Path, default=Path("docs/rl"))
+    parser.add_argument("--confirm", type=int, default=None, metavar="FIRST_SEED",
+                        help="instead: a confirmation on 40 fresh seeds from FIRST_SEED (see confirm())")
+    parser.add_argument("--reference", action="append", default=[], metavar="NAME=POLICY",
+                        help="with --confirm: a reference policy (e.g. champion=champion:out/quick/champion.json, "
+                             "PPO=ppo-sample:out/rl/ppo-shaped-local-env1/model.zip); random and wander always")
     args = parser.parse_args()
+    if args.confirm is not None:
+        confirm(args)
+        return
     stored = stored_rows(args.rows)
     env = parallel_env(environment=1, max_cycles=STEPS, num_robots=20)
     wander = make_policy("wander")
