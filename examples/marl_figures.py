@@ -26,11 +26,13 @@ import csv
 import hashlib
 import json
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from evolution.compare import run_episode
+from evolution.guard import ArgumentParser, UsageError, command, int_arg
 from evolution.policies import make_policy
 from gathering_env import parallel_env
 
@@ -130,16 +132,22 @@ def confirm(args: argparse.Namespace) -> None:
     FIRST_SEED that no setting was chosen on; writes ``paired-marl-env1-2000-seeds<FIRST>.md`` and
     its rows (``marl-confirm-rows.json``) into ``--out``."""
     seeds = list(range(args.confirm, args.confirm + len(SEEDS)))
+    references = []
+    for ref in ["random", "wander", *args.reference]:  # every policy checked before any work
+        name, _, spec = ref.partition("=") if "=" in ref else (ref, "", ref)
+        try:
+            references.append((name, make_policy(spec)))
+        except ValueError as err:
+            raise UsageError(f"--reference {ref}: {err}") from None
+    args.out.mkdir(parents=True, exist_ok=True)
     env = parallel_env(environment=1, max_cycles=STEPS, num_robots=20)
     cache_path = args.out / "marl-confirm-rows.json"
     cache = json.loads(cache_path.read_text()) if cache_path.exists() else {}
     used: set[str] = set()
     by_name = {}
-    for ref in ["random", "wander", *args.reference]:
-        name, _, spec = ref.partition("=") if "=" in ref else (ref, "", ref)
+    for name, policy in references:
         key = f"reference:{name}|env1|{STEPS}|seeds{seeds[0]}-{seeds[-1]}"
         if key not in cache:
-            policy = make_policy(spec)
             cache[key] = {"policy": name, "ft": [run_episode(env, policy, s)["ft"] for s in seeds]}
             cache_path.write_text(json.dumps(cache, indent=1))
         used.add(key)
@@ -154,23 +162,30 @@ def confirm(args: argparse.Namespace) -> None:
     print(out.read_text())
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+@command
+def main(argv: list[str] | None = None) -> int:
+    parser = ArgumentParser(prog="marl_figures.py", description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--runs", type=Path, default=Path("out/marl"))
     parser.add_argument("--rows", type=Path, default=Path("docs/rl/marl-rows.json"),
                         help="per-seed rows of wander, random, the champion and PPO: rl_figures.py's cache (rows.json) "
                              "or this script's own marl-rows.json, which keeps the rows it used")
     parser.add_argument("--out", type=Path, default=Path("docs/rl"))
-    parser.add_argument("--confirm", type=int, default=None, metavar="FIRST_SEED",
+    parser.add_argument("--confirm", type=int_arg(0, 2**31 - 1 - len(SEEDS)), default=None, metavar="FIRST_SEED",
                         help="instead: a confirmation on 40 fresh seeds from FIRST_SEED (see confirm())")
     parser.add_argument("--reference", action="append", default=[], metavar="NAME=POLICY",
                         help="with --confirm: a reference policy (e.g. champion=champion:out/quick/champion.json, "
                              "PPO=ppo-sample:out/rl/ppo-shaped-local-env1/model.zip); random and wander always")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    if not args.runs.is_dir():
+        raise UsageError(f"--runs {args.runs}: not a folder; allowed: a folder of examples/benchmarl_run.py runs")
     if args.confirm is not None:
         confirm(args)
-        return
+        return 0
+    if not args.rows.is_file():
+        raise UsageError(f"--rows {args.rows}: missing; allowed: rl_figures.py's rows.json or a marl-rows.json")
     stored = stored_rows(args.rows)
+    args.out.mkdir(parents=True, exist_ok=True)
     env = parallel_env(environment=1, max_cycles=STEPS, num_robots=20)
     wander = make_policy("wander")
     replayed = [run_episode(env, wander, s)["ft"] for s in SEEDS[:3]]
@@ -210,7 +225,8 @@ def main() -> None:
     plot_curves(curves, float(np.mean(stored["wander"])), args.out / "curves-marl-env1.png")
     print((args.out / "paired-marl-env1-2000.md").read_text())
     print((args.out / "budgets-marl.md").read_text())
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -341,10 +341,7 @@ class NEATReproduction(neat.DefaultReproduction):
                                    offspring, min_size)
         spawn = self._exact_spawn(spawn, offspring, min_size)
 
-        new_population: dict[int, Any] = {}
-        if ratchet:
-            new_population[self.best.key] = self.best  # as it is: not evaluated again
-            self.carried = {self.best.key}
+        new_population = self._start_population(ratchet)
         species.species = {}
         for n, s in zip(spawn, remaining):
             n = max(n, elitism)
@@ -361,6 +358,14 @@ class NEATReproduction(neat.DefaultReproduction):
                                         self.ancestors))
         return new_population
 
+    def _start_population(self, ratchet: bool) -> dict[int, Any]:
+        """The new population before any offspring: the ratchet's best genome, as it is (not
+        evaluated again), or nothing."""
+        if not ratchet:
+            return {}
+        self.carried = {self.best.key}
+        return {self.best.key: self.best}
+
     def _reproduce_original(self, config: Any, species: Any, remaining: list[Any], offspring: int,
                             ratchet: bool) -> dict[int, Any]:
         """Encog's selection (see the class docstring) over the non-stagnant species."""
@@ -370,10 +375,7 @@ class NEATReproduction(neat.DefaultReproduction):
         best_index = next((i for i, s in enumerate(remaining) if best_key in s.members), 0)
         counts = original_spawn([mean([m.fitness for m in s.members.values()]) for s in remaining],
                                 [s.members[ranked[s.key][0]].fitness for s in remaining], best_index, offspring)
-        new_population: dict[int, Any] = {}
-        if ratchet:
-            new_population[self.best.key] = self.best  # as it is: not evaluated again
-            self.carried = {self.best.key}
+        new_population = self._start_population(ratchet)
         species.species = {}
         for n, s in zip(counts, remaining):
             if n <= 0:

@@ -238,14 +238,7 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
             else:
                 sid = next(self.indexer)
                 representatives[sid], members[sid] = gid, [gid]
-        self.genome_to_species = {}
-        for sid in sorted(representatives):
-            species = self.species.get(sid)
-            if species is None:
-                species = self.species[sid] = neat.species.Species(sid, generation)
-            for gid in members[sid]:
-                self.genome_to_species[gid] = sid
-            species.update(population[representatives[sid]], {gid: population[gid] for gid in members[sid]})
+        self._install(population, generation, sorted(representatives), representatives, members)
         # species that found no member are gone (neat-python drops them the same way)
         for sid in [sid for sid in self.species if sid not in representatives]:
             del self.species[sid]
@@ -257,7 +250,8 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
         order = sorted(self.species)
         leader = {sid: self.species[sid].representative.key for sid in order}
         members = {sid: [leader[sid]] for sid in order}
-        others = [gid for gid in sorted(population) if gid not in set(leader.values())]
+        leaders = set(leader.values())
+        others = [gid for gid in sorted(population) if gid not in leaders]
         if not order and others:
             sid = next(self.indexer)
             order, leader, members = [sid], {sid: others[0]}, {sid: list(others)}
@@ -272,6 +266,12 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
                 sid = next(self.indexer)
                 order.append(sid)
                 leader[sid], members[sid] = gid, [gid]
+        self._install(population, generation, order, leader, members)
+
+    def _install(self, population: dict[int, Any], generation: int, order: list[int], representative: dict[int, int],
+                 members: dict[int, list[int]]) -> None:
+        """Make the species ``order`` hold ``members`` (ids) with ``representative`` (an id each),
+        creating the new ones, and record ``genome_to_species``."""
         self.genome_to_species = {}
         for sid in order:
             species = self.species.get(sid)
@@ -279,7 +279,7 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
                 species = self.species[sid] = neat.species.Species(sid, generation)
             for gid in members[sid]:
                 self.genome_to_species[gid] = sid
-            species.update(population[leader[sid]], {gid: population[gid] for gid in members[sid]})
+            species.update(population[representative[sid]], {gid: population[gid] for gid in members[sid]})
 
     @staticmethod
     def _original(a: Any, b: Any, config: Any) -> float:
