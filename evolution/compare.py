@@ -5,6 +5,11 @@
 the same environment and episode seeds and writes ``compare.md`` / ``compare.csv`` (mean ± standard error of
 ft, blocks gathered by type, time to finish) and ``compare.png`` (a bar plot).
 
+``--protocol original`` runs them in the original protocol's world (``evolution.run.protocol``:
+zone 20 x 4, the pickup box at the robot's centre, the Khepera-like IR curve), where a champion of
+an ``S1-original`` run was evolved; the default is the paper's world. A champion evolved in
+another world than the one compared in is named in a note on standard output.
+
 Policies: ``evolution.policies`` (the names ``--policy`` takes are listed there).
 """
 
@@ -21,6 +26,7 @@ import numpy as np
 from evolution.guard import ArgumentParser, check_output_dir, command, int_arg, writing
 from evolution.policies import POLICY_NAMES, Policy, make_policy
 from evolution.run.experiment import LIMITS
+from evolution.run.protocol import PROTOCOLS, protocol_values
 from gathering_env import WorldConfig, parallel_env
 
 
@@ -64,6 +70,21 @@ def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]
             "finished": len(done), "steps_to_finish": float(np.mean(done)) if done else None,
         })
     return rows
+
+
+def world_notes(policies: list[Policy], env_config: dict[str, Any]) -> list[str]:
+    """One line per policy whose own world (a champion's ``environment``) differs from ``env_config``
+    in a key other than the ones a comparison sets on purpose (preset, steps, team size)."""
+    notes = []
+    for policy in policies:
+        own = {k: v for k, v in (policy.environment or {}).items()
+               if k not in ("environment", "max_cycles", "num_robots")}
+        compared = WorldConfig.from_kwargs(**env_config)
+        changed = [f"{k} = {v!r} (here {getattr(compared, k)!r})" for k, v in sorted(own.items())
+                   if hasattr(compared, k) and getattr(compared, k) != v]
+        if changed:
+            notes.append(f"note: {policy.name} was made in another world: {', '.join(changed)}")
+    return notes
 
 
 def standard_error(sample: np.ndarray) -> float | None:
@@ -124,15 +145,22 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--robots", type=int_arg(1, 1000), default=20, help="team size (default 20)")
     parser.add_argument("--episodes", type=int_arg(1, 10_000), default=5, help="episodes (seeds 0..n-1) per policy")
     parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0, help="first episode seed")
+    parser.add_argument("--protocol", choices=PROTOCOLS, default="paper",
+                        help="whose world: paper (default) or original (zone 20 x 4, centre pickup box, "
+                             "Khepera-like IR; evolution.run.protocol)")
     parser.add_argument("--out", type=Path, default=Path("compare"),
                         help="folder for compare.md, compare.csv, compare.png (default compare/)")
     args = parser.parse_args(argv)
     check_output_dir(args.out, COMPARE_FILES)
-    env_config = {"environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots}
+    env_config = {"environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots,
+                  **protocol_values(args.protocol)["environment"]}
     WorldConfig.from_kwargs(**env_config)
     policies = [make_policy(p) for p in args.policy]
+    for line in world_notes(policies, env_config):
+        print(line)
     rows = compare(policies, env_config, list(range(args.seed, args.seed + args.episodes)))
-    title = (f"environment {args.environment}, {args.robots} robots, {args.steps} steps, "
+    title = (f"environment {args.environment}{', original protocol' if args.protocol == 'original' else ''}, "
+             f"{args.robots} robots, {args.steps} steps, "
              f"{args.episodes} episodes (seeds {args.seed}..{args.seed + args.episodes - 1})")
     md, csv_path, png = write_outputs(rows, args.out, title)
     print(md.read_text())

@@ -434,3 +434,33 @@ def test_the_paper_protocols_species_keep_neat_pythons_selection():
     config, population, _ = _population_of_one_species(20, {})
     assert not config.species_set_config.leaders
     assert config.stagnation_config.max_stagnation == 20
+
+
+def test_compare_runs_in_the_protocols_world(tmp_path, monkeypatch, capsys):
+    """gathering-compare --protocol original compares in the original world (zone 4 deep, centre
+    box, Khepera-like IR), the default in the paper's; a champion made in another world is named."""
+    from evolution import compare as compare_module
+    from evolution.policies.base import Policy
+
+    seen = []
+
+    def fake_compare(policies, env_config, seeds):
+        seen.append(env_config)
+        return [{"policy": p.name, "sensors": 1, "episodes": len(seeds), "ft_mean": 0.0, "ft_std": 0.0,
+                 "ft_se": None, "small": 0.0, "medium": 0.0, "large": 0.0, "finished": 0,
+                 "steps_to_finish": None} for p in policies]
+
+    monkeypatch.setattr(compare_module, "compare", fake_compare)
+    for protocol, out in (("original", "o"), ("paper", "p")):
+        assert compare_module.compare_main(["--policy", "wander", "--episodes", "1", "--protocol", protocol,
+                                            "--out", str(tmp_path / out)]) == 0
+    original, paper = seen
+    assert (original["zone_depth"], original["pickup_box"], original["ir_response"]) == (4.0, "centre", "gamma")
+    assert (paper["zone_depth"], paper["pickup_box"], paper["ir_response"]) == (8.0, "front", "linear")
+    assert "original protocol" in (tmp_path / "o" / "compare.md").read_text()
+
+    evolved_there = Policy("champion:x", Morphology.khepera_iii(), None, environment={"environment": 1, **ORIGINAL["environment"]})
+    assert compare_module.world_notes([evolved_there], original) == []
+    note, = compare_module.world_notes([evolved_there], paper)
+    assert "zone_depth = 4.0 (here 8.0)" in note and "pickup_box = 'centre' (here 'front')" in note
+    assert compare_module.world_notes([Policy("wander", Morphology.khepera_iii(), None)], paper) == []
