@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -404,30 +405,58 @@ def _population_of_one_species(size, body):
     return config, population, scores
 
 
-def test_encogs_selection_keeps_the_best_fifth_of_a_species_and_the_ratchet_scores_none_of_them():
-    """Encog's SO selection (speciation = "original"): generation 0 is one species of 20; the
-    ratchet carries the best, the species' best 20 % (4, the best among them) survive too, none
-    of them re-scored, and 16 offspring fill the population; the leader is the species' best."""
+def test_encogs_selection_of_2018_keeps_only_the_ratchets_best(tmp_path):
+    """Encog's SO selection (speciation = "original") with the 2018 code's elite rate 0: generation
+    0 is one species of 20; the ratchet carries the best genome, unscored, and no other genome of
+    generation 0 survives: 19 offspring fill the population; the leader is the species' best."""
     config, population, scores = _population_of_one_species(20, {"speciation": "original", "elitism": "ratchet"})
     assert len(population.species.species) == 1
+    assert config.reproduction_config.original_elite_rate == 0.0
     repro = population.reproduction
     new = repro.reproduce(config, population.species, 20, 0)
     ranked = sorted(scores, key=lambda k: (scores[k], k), reverse=True)
     assert len(new) == 20
-    assert repro.carried == set(ranked[:4])             # the best + the next three of the top 4
-    assert set(new) & set(scores) == set(ranked[:4])    # no other genome of generation 0 survives
+    assert repro.carried == {ranked[0]}
+    assert set(new) & set(scores) == {ranked[0]}        # only the best-ever survives
     (species,) = population.species.species.values()
     assert species.representative.key == ranked[0]      # the leader of the next speciation
     assert config.stagnation_config.max_stagnation == 16
 
 
+def _with_elite_rate(config, rate):
+    config.reproduction_config.original_elite_rate = rate
+    return config
+
+
+def test_encogs_selection_with_an_elite_rate_keeps_the_best_of_a_species_unscored():
+    """original_elite_rate = 0.2 (the code from 2018-12-03 on): the species' best 20 % (4 of 20,
+    the best among them) survive too, none of them re-scored, and 16 offspring fill the population."""
+    config, population, scores = _population_of_one_species(20, {"speciation": "original", "elitism": "ratchet"})
+    repro = population.reproduction
+    new = repro.reproduce(_with_elite_rate(config, 0.2), population.species, 20, 0)
+    ranked = sorted(scores, key=lambda k: (scores[k], k), reverse=True)
+    assert len(new) == 20
+    assert repro.carried == set(ranked[:4])             # the best + the next three of the top 4
+    assert set(new) & set(scores) == set(ranked[:4])    # no other genome of generation 0 survives
+
+
 def test_encogs_selection_without_the_ratchet_keeps_elites_that_are_scored_again():
     config, population, scores = _population_of_one_species(20, {"speciation": "original"})
     repro = population.reproduction
-    new = repro.reproduce(config, population.species, 20, 0)
+    new = repro.reproduce(_with_elite_rate(config, 0.2), population.species, 20, 0)
     ranked = sorted(scores, key=lambda k: (scores[k], k), reverse=True)
     assert len(new) == 20 and not repro.carried
     assert set(new) & set(scores) == set(ranked[:4])    # 20 % of 20 survive as they are
+
+
+def test_an_elite_rate_outside_0_1_is_refused(tmp_path, capsys):
+    cfg = tmp_path / "bad.neat.cfg"
+    shipped = (Path(__file__).parents[1] / "configs" / "hyperneat_m.neat.cfg").read_text()
+    cfg.write_text(shipped.replace("[NEATReproduction]\n", "[NEATReproduction]\noriginal_elite_rate = 1.5\n"))
+    exp = experiment(tmp_path, body=f'protocol = "original"\nneat_config = "{cfg}"')
+    assert evolve_main([str(exp), "--out", str(tmp_path / "r"), "--workers", "1", "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bad.neat.cfg" in err[0] and "original_elite_rate = 1.5" in err[0] and "[0, 1]" in err[0]
 
 
 def test_the_paper_protocols_species_keep_neat_pythons_selection():

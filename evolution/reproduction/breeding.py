@@ -208,9 +208,12 @@ def breed(candidates: list[int], genomes: dict[int, Any], score: dict[int, float
     return children
 
 
-#: Encog's species elitism in the original's single-objective runs (``SingleObjectiveEA``,
-#: ``setEliteRate(0.2)``): the best 20 % of every species of more than 5 genomes survive as they are.
-ORIGINAL_ELITE_RATE, ORIGINAL_ELITE_MIN_MEMBERS = 0.2, 5
+#: Encog's species elitism in the original's single-objective runs (``SingleObjectiveEA``'s
+#: elite rate: the best fraction of every species of more than 5 genomes survives as it is). The
+#: 2018 code that has the paper's convergence stop, time bonus 20 and 5 trials sets it to 0 (only
+#: the ratchet's best genome survives); the commit that removed the stop (2018-12-03) set 0.2.
+#: ``[NEATReproduction] original_elite_rate`` overrides it.
+ORIGINAL_ELITE_RATE, ORIGINAL_ELITE_MIN_MEMBERS = 0.0, 5
 #: Encog's stagnation in its speciation: a species is removed after more than 15 generations
 #: without improvement (neat-python's ``max_stagnation`` counts to 16), except the best species.
 ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM = 16, 1
@@ -258,7 +261,7 @@ class NEATReproduction(neat.DefaultReproduction):
     """neat-python's NEAT selection (fitness sharing, stagnation, elitism) with ``breed``.
 
     Config section ``[NEATReproduction]``: ``elitism`` and ``min_species_size`` as in
-    neat-python's ``DefaultReproduction``; the truncation fraction is the genome section's
+    neat-python's ``DefaultReproduction``, ``original_elite_rate`` for Encog's selection (below); the truncation fraction is the genome section's
     ``parent_fraction`` (one value shared with the MO arm).
 
     **Ratchet** (``config.reproduction_config.ratchet = True``, set from the experiment's
@@ -270,10 +273,11 @@ class NEATReproduction(neat.DefaultReproduction):
 
     **Encog's selection** (with the species set's Encog ``leaders``: ``speciation =
     "original"`` in SO): offspring counts by ``original_spawn`` from each species' mean
-    fitness (no damping by the previous size, no minimum per species); the best 20 % of
-    every species of more than 5 genomes survive unchanged (``ORIGINAL_ELITE_RATE``; carried
-    unscored with the ratchet, as Encog does not score them again) and count towards its
-    offspring; each species' best genome becomes its leader for the next speciation.
+    fitness (no damping by the previous size, no minimum per species); with
+    ``original_elite_rate`` r > 0 (default 0, the 2018 code's), the best fraction r of every
+    species of more than 5 genomes survives unchanged (carried unscored with the ratchet, as
+    Encog does not score them again) and counts towards its offspring; each species' best
+    genome becomes its leader for the next speciation.
     """
 
     def __init__(self, config: Any, reporters: Any, stagnation: Any) -> None:
@@ -287,7 +291,9 @@ class NEATReproduction(neat.DefaultReproduction):
             raise ValueError(f"[{cls.__name__}] survival_threshold: set the truncation fraction as parent_fraction "
                              "in the genome section (shared by the SO and MO arms)")
         return DefaultClassConfig(param_dict, [ConfigParameter("elitism", int, 0),
-                                               ConfigParameter("min_species_size", int, 1)], cls.__name__)
+                                               ConfigParameter("min_species_size", int, 1),
+                                               ConfigParameter("original_elite_rate", float, ORIGINAL_ELITE_RATE)],
+                                  cls.__name__)
 
     def _exact_spawn(self, spawn: list[int], total: int, min_size: int) -> list[int]:
         """neat-python's ``_adjust_spawn_exact``, repeated: it gives up after one pass over the
@@ -386,7 +392,7 @@ class NEATReproduction(neat.DefaultReproduction):
             s.representative = members[order[0]]  # the leader of the next speciation
             species.species[s.key] = s
             if len(order) > ORIGINAL_ELITE_MIN_MEMBERS:
-                for k in order[:min(n, int(len(order) * ORIGINAL_ELITE_RATE))]:
+                for k in order[:min(n, int(len(order) * config.reproduction_config.original_elite_rate))]:
                     if ratchet and k == self.best.key:
                         continue  # already carried (Encog skips the old best without counting it)
                     new_population[k] = members[k]

@@ -147,13 +147,16 @@ def check_neat_config(config: neat.Config, path: Path) -> None:
     if stagnation.species_elitism < 0:
         raise bad("DefaultStagnation", "species_elitism", stagnation.species_elitism, "an integer >= 0")
     reproduction = config.reproduction_config
-    if config.reproduction_type is neat.DefaultReproduction:
+    if issubclass(config.reproduction_type, neat.DefaultReproduction):
+        name = config.reproduction_type.__name__
         if reproduction.elitism < 0:
-            raise bad("DefaultReproduction", "elitism", reproduction.elitism, "an integer >= 0")
-        if not 0.0 < reproduction.survival_threshold <= 1.0:
-            raise bad("DefaultReproduction", "survival_threshold", reproduction.survival_threshold, "(0, 1]")
+            raise bad(name, "elitism", reproduction.elitism, "an integer >= 0")
+        if hasattr(reproduction, "survival_threshold") and not 0.0 < reproduction.survival_threshold <= 1.0:
+            raise bad(name, "survival_threshold", reproduction.survival_threshold, "(0, 1]")
         if reproduction.min_species_size < 1:
-            raise bad("DefaultReproduction", "min_species_size", reproduction.min_species_size, "an integer >= 1")
+            raise bad(name, "min_species_size", reproduction.min_species_size, "an integer >= 1")
+        if hasattr(reproduction, "original_elite_rate") and not 0.0 <= reproduction.original_elite_rate <= 1.0:
+            raise bad(name, "original_elite_rate", reproduction.original_elite_rate, "[0, 1]")
 
 
 def substrate_for(experiment: Experiment) -> Any:
