@@ -19,7 +19,8 @@ key                           paper (default)     original
 ``[experiment] speciation``   (the neat config's  ``"original"``: Encog's distance and threshold
                               ``species_mode``)   rule (``evolution.reproduction.species``); in SO
                                                   also Encog's species of leaders, offspring
-                                                  shares, 20 % species elites and stagnation 15
+                                                  shares, no species elites (the 2018 code's
+                                                  rate 0) and stagnation 15
                                                   (``evolution.reproduction.breeding``)
 ``[environment] zone_depth``  8                   4 (zone 20 x 4)
 ``[environment] pickup_box``  ``"front"``         ``"centre"``, 0.1 forward x 0.2 across

@@ -62,8 +62,8 @@ def protocol_notes(exp: Experiment) -> list[str]:
     if exp.elitism == "ratchet" and not exp.multi_objective:
         carried = "the best-ever genome is carried over"
         if exp.speciation == "original":
-            carried = ("the best-ever genome and Encog's species elites (the best 20 % of each species of more "
-                       "than 5) are carried over")
+            carried = ("the best-ever genome (and Encog's species elites, if [NEATReproduction] "
+                       "original_elite_rate > 0; the 2018 code's is 0) is carried over")
         notes.append(f"{exp.name}: ratchet (elitism = ratchet): {carried} with their stored scores and not "
                      "evaluated again; only offspring are scored")
     return notes
