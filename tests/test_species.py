@@ -217,6 +217,33 @@ def test_original_species_of_leaders_by_hand(tmp_path):
     assert species.species[4].representative.key == 13
 
 
+def test_original_threshold_has_no_floor_and_below_0_every_genome_founds_a_species(tmp_path):
+    """Encog's threshold falls by 0.01 while fewer than 2 species survive, past 0 (adaptive mode
+    stops at threshold_min): from 0.005 to -0.005, where no genome joins the leader, not even
+    one identical to it; then 3 species survive (> max 2 here) and it climbs back by 0.01."""
+    config = make_neat_config(load_experiment(None, {"population": 6, "speciation": "original"}))
+    config.species_set_config.max_species = 2
+    species = GatheringSpeciesSet(config.species_set_config, neat.reporting.ReporterSet())
+
+    def genome(key, w):
+        g = genome_with([(1, w)])
+        g.key = key
+        return g
+
+    leader = genome(1, 0.0)
+    species.species[1] = neat.species.Species(1, 0)
+    species.species[1].update(leader, {1: leader})
+    species.indexer = iter(range(2, 100))
+    species.history.append((0, 0.005, 1))
+    species.threshold = 0.005
+    population = {1: leader, 10: genome(10, 0.0), 11: genome(11, 0.01)}
+    species.speciate(config, population, 1)
+    assert species.history[-1][1] == pytest.approx(-0.005)
+    assert sorted(sorted(s.members) for s in species.species.values()) == [[1], [10], [11]]
+    species.speciate(config, population, 2)
+    assert species.history[-1][1] == pytest.approx(0.005)
+
+
 def test_run_statistics_record_threshold_and_species(tmp_path):
     from tests.small_runs import SMALL_WORLD
     exp = tmp_path / "e.toml"

@@ -23,7 +23,9 @@ speciation, by ``species_mode`` in its config section ``[GatheringSpeciesSet]``:
   sensor genes (NEAT-M) their sensor term; before genomes are assigned, the threshold moves by
   ``threshold_step`` (0.01, additive): up when the previous generation had more than
   ``max_species`` species (40 in SO, the population in MO), down when fewer than
-  ``min_species`` (2); it starts at ``compatibility_threshold`` (1.0). In single-objective runs
+  ``min_species`` (2); it starts at ``compatibility_threshold`` (1.0) and has no floor (below 0
+  every genome but the leaders founds a species, so the count jumps and the threshold climbs
+  back; ``threshold_min`` is the adaptive rule's). In single-objective runs
   species are also Encog's (``leaders``, set by ``use_original_rule``): generation 0 is one
   species; a species is represented by its *leader* (its best genome, which
   ``NEATReproduction`` names after each evaluation) and is disbanded when its leader is not in
@@ -36,8 +38,8 @@ The threshold and the species count of every generation are in ``history`` (and 
 statistics, ``threshold`` and ``species``). Keys and defaults: ``compatibility_threshold``
 (the start), ``species_mode = adaptive``, ``target_species = 0.1`` (a count, or a fraction of
 the population: 15 at N = 150), ``threshold_step = 0.1``,
-``threshold_min = 0.01``, ``max_species = 40``, ``min_species = 2`` (the last two only for
-``original``).
+``threshold_min = 0.01`` (``adaptive`` only), ``max_species = 40``, ``min_species = 2`` (the
+last two only for ``original``).
 """
 
 from __future__ import annotations
@@ -188,7 +190,7 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
             if survivors > cfg.max_species:
                 self.threshold += cfg.threshold_step
             elif survivors < cfg.min_species:
-                self.threshold = max(cfg.threshold_min, self.threshold - cfg.threshold_step)
+                self.threshold -= cfg.threshold_step  # Encog has no floor: below 0 no genome joins a leader
         used = self.threshold
         before = set(self.species)
         if leaders:
