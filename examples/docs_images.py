@@ -119,10 +119,17 @@ ORIGINAL_S1_FILES = ("stats.png", "stats.jsonl", "stats.csv", "experiment.json",
 
 def make_original_s1(args: argparse.Namespace) -> None:
     """The original-protocol S1 run's figure and small files (``--original-s1 DIR``: its run
-    directory, ``gathering-evolve S1-original``; hours of CPU)."""
+    directory, ``gathering-evolve S1-original``; hours of CPU). A run still going has no
+    ``stats.png`` yet: it is drawn from its statistics."""
     for name in ORIGINAL_S1_FILES:
         if (args.original_s1 / name).exists():
             shutil.copy2(args.original_s1 / name, DOCS / "evidence" / "original-S1" / name)
+        elif name == "stats.png":
+            from evolution.run.plots import plot_run
+            from evolution.run.stats import read_stats
+
+            plot_run(read_stats(args.original_s1 / "stats.jsonl"), DOCS / "evidence" / "original-S1" / name,
+                     title="S1-original")
 
 
 LEARNING_FILES = ("learning.png", "learning.json", "learning.md")

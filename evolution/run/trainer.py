@@ -64,7 +64,7 @@ def protocol_notes(exp: Experiment) -> list[str]:
         if exp.speciation == "original":
             carried = ("the best-ever genome (and Encog's species elites, if [NEATReproduction] "
                        "original_elite_rate > 0; the 2018 code's is 0) is carried over")
-        notes.append(f"{exp.name}: ratchet (elitism = ratchet): {carried} with their stored scores and not "
+        notes.append(f"{exp.name}: ratchet (elitism = ratchet): {carried}, with stored scores, and not "
                      "evaluated again; only offspring are scored")
     return notes
 
