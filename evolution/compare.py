@@ -26,6 +26,7 @@ import numpy as np
 from evolution.guard import ArgumentParser, check_output_dir, command, int_arg, writing
 from evolution.policies import POLICY_NAMES, Policy, make_policy
 from evolution.run.experiment import LIMITS
+from evolution.run.lock import LOCK_FILE, RunLock
 from evolution.run.protocol import PROTOCOLS, protocol_values
 from gathering_env import WorldConfig, parallel_env
 
@@ -76,10 +77,10 @@ def world_notes(policies: list[Policy], env_config: dict[str, Any]) -> list[str]
     """One line per policy whose own world (a champion's ``environment``) differs from ``env_config``
     in a key other than the ones a comparison sets on purpose (preset, steps, team size)."""
     notes = []
+    compared = WorldConfig.from_kwargs(**env_config)
     for policy in policies:
         own = {k: v for k, v in (policy.environment or {}).items()
                if k not in ("environment", "max_cycles", "num_robots")}
-        compared = WorldConfig.from_kwargs(**env_config)
         changed = [f"{k} = {v!r} (here {getattr(compared, k)!r})" for k, v in sorted(own.items())
                    if hasattr(compared, k) and getattr(compared, k) != v]
         if changed:
@@ -103,7 +104,7 @@ def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Pa
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    check_output_dir(out, COMPARE_FILES)
+    check_output_dir(out, (*COMPARE_FILES, LOCK_FILE))
     out.mkdir(parents=True, exist_ok=True)
     csv_path = out / "compare.csv"
     with writing(csv_path), open(csv_path, "w", newline="") as f:
@@ -151,18 +152,20 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("compare"),
                         help="folder for compare.md, compare.csv, compare.png (default compare/)")
     args = parser.parse_args(argv)
-    check_output_dir(args.out, COMPARE_FILES)
+    check_output_dir(args.out, (*COMPARE_FILES, LOCK_FILE))
     env_config = {"environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots,
                   **protocol_values(args.protocol)["environment"]}
     WorldConfig.from_kwargs(**env_config)
     policies = [make_policy(p) for p in args.policy]
     for line in world_notes(policies, env_config):
         print(line)
-    rows = compare(policies, env_config, list(range(args.seed, args.seed + args.episodes)))
     title = (f"environment {args.environment}{', original protocol' if args.protocol == 'original' else ''}, "
              f"{args.robots} robots, {args.steps} steps, "
              f"{args.episodes} episodes (seeds {args.seed}..{args.seed + args.episodes - 1})")
-    md, csv_path, png = write_outputs(rows, args.out, title)
+    # one writer per --out: a second copy stops here, before any episode
+    with RunLock(args.out, what="output folder", by="another gathering-compare"):
+        rows = compare(policies, env_config, list(range(args.seed, args.seed + args.episodes)))
+        md, csv_path, png = write_outputs(rows, args.out, title)
     print(md.read_text())
     print(f"wrote {md}, {csv_path}, {png}")
     return 0

@@ -200,6 +200,16 @@ def main(argv: list[str] | None = None) -> int:
     unknown = [s for s in chosen if s not in STEPS]
     if unknown:
         parser.error(f"--only {args.only}: unknown step {unknown[0]!r}; allowed: {', '.join(STEPS)}")
+    for key in ("original_s1", "marl", "learning", "evidence", "rl"):
+        folder = getattr(args, key)
+        if folder is not None and not folder.is_dir():
+            print(f"error: --{key.replace('_', '-')} {folder}: no such folder; allowed: an existing folder of runs",
+                  file=sys.stderr)
+            return 2
+    if args.original_s1 is not None and not (args.original_s1 / "stats.jsonl").is_file():
+        print(f"error: --original-s1 {args.original_s1}: no stats.jsonl; allowed: a run directory of "
+              "gathering-evolve S1-original", file=sys.stderr)
+        return 2
     for name in chosen:
         step = STEPS[name]
         if step.needs and getattr(args, step.needs) is None:

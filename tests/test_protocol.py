@@ -405,7 +405,7 @@ def _population_of_one_species(size, body):
     return config, population, scores
 
 
-def test_encogs_selection_of_2018_keeps_only_the_ratchets_best(tmp_path):
+def test_encogs_selection_of_2018_keeps_only_the_ratchets_best():
     """Encog's SO selection (speciation = "original") with the 2018 code's elite rate 0: generation
     0 is one species of 20; the ratchet carries the best genome, unscored, and no other genome of
     generation 0 survives: 19 offspring fill the population; the leader is the species' best."""
@@ -493,3 +493,17 @@ def test_compare_runs_in_the_protocols_world(tmp_path, monkeypatch, capsys):
     note, = compare_module.world_notes([evolved_there], paper)
     assert "zone_depth = 4.0 (here 8.0)" in note and "pickup_box = 'centre' (here 'front')" in note
     assert compare_module.world_notes([Policy("wander", Morphology.khepera_iii(), None)], paper) == []
+
+
+def test_a_second_compare_into_the_same_folder_is_refused(tmp_path, capsys):
+    """One writer per gathering-compare --out: while another holds it, one line, exit 2, no file."""
+    from evolution.compare import compare_main
+    from evolution.run.lock import RunLock
+
+    out = tmp_path / "cmp"
+    with RunLock(out, what="output folder", by="another gathering-compare"):
+        assert compare_main(["--policy", "random", "--steps", "5", "--episodes", "1", "--out", str(out)]) == 2
+        assert sorted(p.name for p in out.iterdir()) == [".lock"]
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "in use by process" in err[0] and str(out) in err[0]
+    assert compare_main(["--policy", "random", "--steps", "5", "--episodes", "1", "--out", str(out)]) == 0

@@ -217,7 +217,7 @@ def test_original_species_of_leaders_by_hand(tmp_path):
     assert species.species[4].representative.key == 13
 
 
-def test_original_threshold_has_no_floor_and_below_0_every_genome_founds_a_species(tmp_path):
+def test_original_threshold_has_no_floor_and_below_0_every_genome_founds_a_species():
     """Encog's threshold falls by 0.01 while fewer than 2 species survive, past 0 (adaptive mode
     stops at threshold_min): from 0.005 to -0.005, where no genome joins the leader, not even
     one identical to it; then 3 species survive (> max 2 here) and it climbs back by 0.01."""

@@ -261,8 +261,9 @@ class NEATReproduction(neat.DefaultReproduction):
     """neat-python's NEAT selection (fitness sharing, stagnation, elitism) with ``breed``.
 
     Config section ``[NEATReproduction]``: ``elitism`` and ``min_species_size`` as in
-    neat-python's ``DefaultReproduction``, ``original_elite_rate`` for Encog's selection (below); the truncation fraction is the genome section's
-    ``parent_fraction`` (one value shared with the MO arm).
+    neat-python's ``DefaultReproduction``, ``original_elite_rate`` for Encog's selection
+    (below); the truncation fraction is the genome section's ``parent_fraction`` (one value
+    shared with the MO arm).
 
     **Ratchet** (``config.reproduction_config.ratchet = True``, set from the experiment's
     ``elitism = "ratchet"``; the original code's SO elitism): the best genome ever seen (by

@@ -46,8 +46,9 @@ class RunLock:
     ``check()`` raises if the run directory was deleted or replaced under the holder.
     """
 
-    def __init__(self, run_dir: Path) -> None:
+    def __init__(self, run_dir: Path, what: str = "run directory", by: str = "a gathering-evolve run") -> None:
         self.run_dir = Path(run_dir)
+        self.what, self.by = what, by  # for the refusal: "<dir>: <what> is in use by process N (<by>)"
         self.path = self.run_dir / LOCK_FILE
         self._fd: int | None = None
 
@@ -79,8 +80,8 @@ class RunLock:
                 holder = _read_pid(fd)
             os.close(fd)
             who = f"process {holder}" if holder else "another process"
-            raise UsageError(f"{self.run_dir}: run directory is in use by {who} (a gathering-evolve run); "
-                             "allowed: one writer per run directory: wait for it to end, or choose another "
+            raise UsageError(f"{self.run_dir}: {self.what} is in use by {who} ({self.by}); "
+                             f"allowed: one writer per {self.what}: wait for it to end, or choose another "
                              "--out") from None
         except BaseException:
             os.close(fd)
