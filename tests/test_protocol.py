@@ -507,3 +507,30 @@ def test_a_second_compare_into_the_same_folder_is_refused(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "in use by process" in err[0] and str(out) in err[0]
     assert compare_main(["--policy", "random", "--steps", "5", "--episodes", "1", "--out", str(out)]) == 0
+
+
+@pytest.mark.parametrize("case", ["incumbent ties", "two members beat it"])
+def test_encogs_leader_keeps_its_place_on_a_tie(case):
+    """Encog's leader (``addSpeciesMember``): a member replaces the leader only when it scores
+    strictly higher. On a tie the incumbent stays the leader (so with elite rate 0 the species of
+    the ratchet's best survives: its leader is carried); of two members that beat it with the same
+    score, the one with the lower key (the first to join) leads."""
+    config, population, scores = _population_of_one_species(20, {"speciation": "original", "elitism": "ratchet"})
+    (species,) = population.species.species.values()
+    keys = sorted(species.members)
+    incumbent = keys[10]                    # the leader the species was speciated against
+    species.representative = species.members[incumbent]
+    others = [k for k in keys if k != incumbent]
+    for k, g in species.members.items():
+        g.fitness = 1.0
+    species.members[incumbent].fitness = 50.0
+    if case == "incumbent ties":
+        for k in (keys[0], keys[-1]):      # an older and a younger genome, same score
+            species.members[k].fitness = 50.0
+        expected = incumbent
+    else:
+        species.members[others[3]].fitness = species.members[others[7]].fitness = 60.0
+        expected = others[3]
+    population.reproduction.reproduce(config, population.species, 20, 0)
+    (species,) = population.species.species.values()
+    assert species.representative.key == expected

@@ -219,6 +219,21 @@ ORIGINAL_ELITE_RATE, ORIGINAL_ELITE_MIN_MEMBERS = 0.0, 5
 ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM = 16, 1
 
 
+def original_leader(members: dict[int, Any], incumbent: int) -> int:
+    """Encog's species leader after a generation (``ThresholdSpeciation.addSpeciesMember``).
+
+    The species starts from its leader (``incumbent``: the one it was speciated against, or its
+    founder), members join in key order, and a member takes over only when it scores *strictly*
+    higher than the leader so far: the incumbent keeps the place on a tie, else the lowest key of
+    the best score wins. (Ranking by score alone hands a tie to a new offspring; with elite rate
+    0 that offspring is not carried, so the species is disbanded at the next speciation.)
+    """
+    top = max(g.fitness for g in members.values())
+    if incumbent in members and members[incumbent].fitness >= top:
+        return incumbent
+    return min(k for k, g in members.items() if g.fitness >= top)
+
+
 def java_round(x: float) -> int:
     """Java's ``Math.round`` (halves round up), as Encog rounds offspring shares."""
     return int(math.floor(x + 0.5))
@@ -390,7 +405,7 @@ class NEATReproduction(neat.DefaultReproduction):
             members = dict(s.members)
             order = ranked[s.key]
             s.members = {}
-            s.representative = members[order[0]]  # the leader of the next speciation
+            s.representative = members[original_leader(members, s.representative.key)]  # of the next speciation
             species.species[s.key] = s
             if len(order) > ORIGINAL_ELITE_MIN_MEMBERS:
                 for k in order[:min(n, int(len(order) * config.reproduction_config.original_elite_rate))]:
