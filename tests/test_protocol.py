@@ -521,7 +521,7 @@ def test_encogs_leader_keeps_its_place_on_a_tie(case):
     incumbent = keys[10]                    # the leader the species was speciated against
     species.representative = species.members[incumbent]
     others = [k for k in keys if k != incumbent]
-    for k, g in species.members.items():
+    for g in species.members.values():
         g.fitness = 1.0
     species.members[incumbent].fitness = 50.0
     if case == "incumbent ties":

@@ -293,7 +293,8 @@ class NEATReproduction(neat.DefaultReproduction):
     ``original_elite_rate`` r > 0 (default 0, the 2018 code's), the best fraction r of every
     species of more than 5 genomes survives unchanged (carried unscored with the ratchet, as
     Encog does not score them again) and counts towards its offspring; each species' best
-    genome becomes its leader for the next speciation.
+    genome becomes its leader for the next speciation (``original_leader``: on a tie the
+    leader keeps its place).
     """
 
     def __init__(self, config: Any, reporters: Any, stagnation: Any) -> None:

@@ -28,10 +28,12 @@ speciation, by ``species_mode`` in its config section ``[GatheringSpeciesSet]``:
   back; ``threshold_min`` is the adaptive rule's). In single-objective runs
   species are also Encog's (``leaders``, set by ``use_original_rule``): generation 0 is one
   species; a species is represented by its *leader* (its best genome, which
-  ``NEATReproduction`` names after each evaluation) and is disbanded when its leader is not in
-  the new population; a genome joins the first species, oldest first, whose leader is within
-  the threshold (``<=``), else it founds a new one. (neat-python instead keeps every species
-  that finds a closest genome and puts a genome in the nearest species.)
+  ``NEATReproduction`` names after each evaluation; on a tie the leader keeps its place) and
+  is disbanded when its leader is not in the new population; a genome joins the first
+  species, oldest first, whose leader is within the threshold (``<=``), else it founds a new
+  one. If every species was disbanded (Encog stops there with an error), the population is one
+  species again, as in generation 0. (neat-python instead keeps every species that finds a
+  closest genome and puts a genome in the nearest species.)
 * ``fixed``: neat-python's behaviour (the threshold never moves).
 
 The threshold and the species count of every generation are in ``history`` (and the run's
