@@ -534,3 +534,24 @@ def test_encogs_leader_keeps_its_place_on_a_tie(case):
     population.reproduction.reproduce(config, population.species, 20, 0)
     (species,) = population.species.species.values()
     assert species.representative.key == expected
+
+
+def test_the_ratchets_species_survives_a_tie_with_a_younger_genome():
+    """The symptom the tie rule cured: with elite rate 0 only the ratchet's best is carried, so
+    its species lives on only if that genome stays its leader. A younger genome scoring the same
+    must not take the place: after the next speciation the species still exists, led by the
+    carried genome (ranking by score alone let the young genome lead, the species was disbanded
+    and the population lumped into a new one)."""
+    config, population, scores = _population_of_one_species(20, {"speciation": "original", "elitism": "ratchet"})
+    species_set = population.species
+    (sid,) = species_set.species
+    founder = species_set.species[sid].representative.key
+    youngest = max(species_set.species[sid].members)
+    for g in species_set.species[sid].members.values():
+        g.fitness = 1.0
+    species_set.species[sid].members[founder].fitness = species_set.species[sid].members[youngest].fitness = 40.0
+    new = population.reproduction.reproduce(config, species_set, 20, 0)
+    assert population.reproduction.carried == {founder} and youngest not in new
+    species_set.speciate(config, new, 1)
+    assert sid in species_set.species
+    assert species_set.species[sid].representative.key == founder
