@@ -35,6 +35,16 @@ REWARD_SCOPES: tuple[str, str] = ("team", "local")
 
 #: Where the pickup box sits (``WorldConfig.pickup_box``).
 PICKUP_BOXES: tuple[str, str] = ("front", "centre")
+GROUND_FRICTIONS: tuple[str, str] = ("threshold", "mass")
+GRAVITY = 9.81
+"""Acceleration of gravity (units/s^2) that turns mass into ground friction ('mass')."""
+MASS_FRICTION = 0.1
+"""'mass' ground friction: the original code's kinetic coefficient (force = 0.1 * m * g)."""
+MASS_TORQUE_FRICTION = 0.01
+"""'mass' ground friction: the original's kinetic torque coefficient (torque = 0.01 * m * g,
+the same for every shape, as the original's)."""
+THRESHOLD_TORQUE_ARM = 0.38
+"""'threshold' ground friction: torque = force * this * block side."""
 
 #: Names of the three block types, index = type id.
 BLOCK_TYPE_NAMES: tuple[str, str, str] = ("small", "medium", "large")
@@ -87,6 +97,18 @@ class WorldConfig:
     so k - 1 robots at full drive cannot move it and k robots can. In (0, 1)."""
     block_friction: float = 0.7
     """Contact (Coulomb) friction of block shapes."""
+    ground_friction: str = "threshold"
+    """Blocks' friction with the floor: 'threshold' (a block needing k robots resists with
+    (k - block_friction_margin) * robot_drive_force, so k - 1 robots cannot move it and k can)
+    or 'mass' (the original code: kinetic Coulomb friction 0.1 * m * g, torque 0.01 * m * g,
+    whatever the robots needed; ``gathering_env.ground``)."""
+    robot_restitution: float = 0.0
+    """Restitution (bounciness) of robots; a contact takes the larger of its two shapes' (as
+    Box2D does). 0: contacts absorb the approach speed; the original code: 1 (fully elastic)."""
+    block_restitution: float = 0.0
+    """Restitution of blocks (the original code: 0.4)."""
+    wall_restitution: float = 0.0
+    """Restitution of the arena walls (the original code: 1)."""
 
     # --- gathering zone --------------------------------------------------------------
     zone_width: float = 20.0
@@ -192,6 +214,8 @@ class WorldConfig:
             _check_float(name, getattr(self, name), 0.0, math.inf, low_open=True)
         for name in ("robot_friction", "block_friction", "time_bonus", "attach_reward"):
             _check_float(name, getattr(self, name), 0.0, math.inf)
+        for name in ("robot_restitution", "block_restitution", "wall_restitution"):
+            _check_float(name, getattr(self, name), 0.0, 1.0)
         _check_float("block_friction_margin", self.block_friction_margin, 0.0, 1.0,
                      low_open=True, high_open=True)
         for i, count in enumerate(self.block_counts):
@@ -217,6 +241,9 @@ class WorldConfig:
                 raise ValueError(f"{name}={value!r} must be a bool (True or False)")
         if self.pickup_box not in PICKUP_BOXES:
             raise ValueError(f"pickup_box={self.pickup_box!r}; allowed: {', '.join(map(repr, PICKUP_BOXES))}")
+        if self.ground_friction not in GROUND_FRICTIONS:
+            raise ValueError(f"ground_friction={self.ground_friction!r}; allowed: "
+                             f"{', '.join(map(repr, GROUND_FRICTIONS))}")
         if self.ir_response not in ("linear", "gamma"):
             raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma'")
         if self.reward not in REWARDS:
@@ -254,10 +281,14 @@ class WorldConfig:
         """Sum of the values of all blocks in the world (v_t of eq. 1)."""
         return float(sum(c * v for c, v in zip(self.block_counts, self.block_values)))
 
-    def block_ground_friction(self, block_type: int) -> float:
-        """Ground friction force (force units) of a block of the given type."""
+    def block_ground_friction(self, block_type: int) -> tuple[float, float]:
+        """Ground friction (force, torque) of a block of the given type (``ground_friction``)."""
+        if self.ground_friction == "mass":
+            weight = self.block_masses[block_type] * GRAVITY
+            return MASS_FRICTION * weight, MASS_TORQUE_FRICTION * weight
         need = self.robots_needed[block_type]
-        return (need - self.block_friction_margin) * self.robot_drive_force
+        force = (need - self.block_friction_margin) * self.robot_drive_force
+        return force, force * THRESHOLD_TORQUE_ARM * self.block_sizes[block_type]
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe dict of every field (tuples become lists)."""

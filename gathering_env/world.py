@@ -3,8 +3,11 @@
 Top-down 2D without gravity. Ground friction, which pymunk lacks top-down, is modelled
 the usual pymunk way: each block is tied to the static body by a ``PivotJoint`` and a
 ``GearJoint`` with ``max_bias = 0`` whose ``max_force``/``max_torque`` equal the friction
-force/torque. A block needing k robots gets the friction ``(k - margin) * F_drive``, so
-k - 1 robots pushing at full drive cannot move it and k robots can.
+force/torque (``WorldConfig.block_ground_friction``). By default (``ground_friction =
+"threshold"``) a block needing k robots gets the friction ``(k - margin) * F_drive``, so
+k - 1 robots pushing at full drive cannot move it and k robots can; ``"mass"`` gives the
+original code's kinetic friction 0.1 * m * g instead. Contact restitution is mixed as Box2D
+mixes it (``gathering_env.contacts``).
 
 Each robot is driven through a kinematic *control body* (pymunk's tank example): a pivot
 and a gear joint with ``max_bias = 0`` pull the robot's velocity towards the control
@@ -28,6 +31,7 @@ import pymunk
 import pymunk.batch as pbatch
 
 from .config import WorldConfig
+from .contacts import apply_restitution
 
 _VEL = pbatch.BodyFields.VELOCITY | pbatch.BodyFields.ANGULAR_VELOCITY
 _STATE = pbatch.BodyFields.POSITION | pbatch.BodyFields.ANGLE | _VEL
@@ -86,7 +90,7 @@ class GatheringWorld:
         # pymunk's default allowed overlap (0.1) is two thirds of a robot radius at our scale.
         space.collision_slop = 0.005
         self.space = space
-        self._add_walls()
+        walls = self._add_walls()
 
         types = np.repeat(np.arange(3), cfg.block_counts)
         self.block_type = types
@@ -98,6 +102,8 @@ class GatheringWorld:
         robot_angles = rng.uniform(-math.pi, math.pi, size=cfg.num_robots)
 
         self.robot_bodies: list[pymunk.Body] = []
+        robot_shapes: list[pymunk.Shape] = []
+        block_shapes: list[pymunk.Shape] = []
         moment = pymunk.moment_for_circle(cfg.robot_mass, 0.0, cfg.robot_radius)
         for (x, y), a in zip(robot_xy, robot_angles):
             body = pymunk.Body(cfg.robot_mass, moment)
@@ -107,6 +113,7 @@ class GatheringWorld:
             shape.friction = cfg.robot_friction
             space.add(body, shape)
             self.robot_bodies.append(body)
+            robot_shapes.append(shape)
 
         self.block_bodies: list[pymunk.Body] = []
         for t, (x, y), a in zip(types, block_xy, block_angles):
@@ -118,9 +125,11 @@ class GatheringWorld:
             shape = pymunk.Poly.create_box(body, (size, size))
             shape.friction = cfg.block_friction
             space.add(body, shape)
-            friction = cfg.block_ground_friction(int(t))
-            self._add_ground_friction(body, friction, friction * 0.38 * size)
+            block_shapes.append(shape)
+            self._add_ground_friction(body, *cfg.block_ground_friction(int(t)))
             self.block_bodies.append(body)
+
+        apply_restitution(space, {"robot": robot_shapes, "block": block_shapes, "wall": walls}, cfg)
 
         self.control_bodies: list[pymunk.Body] = []
         for body in self.robot_bodies:
@@ -161,14 +170,17 @@ class GatheringWorld:
             target[...] = getattr(self, name)
             setattr(self, name, target)
 
-    def _add_walls(self) -> None:
+    def _add_walls(self) -> list[pymunk.Shape]:
         cfg, r = self.config, _WALL_RADIUS
         w, h = cfg.arena_width, cfg.arena_height
         corners = [(-r, -r), (w + r, -r), (w + r, h + r), (-r, h + r)]
+        walls = []
         for a, b in zip(corners, corners[1:] + corners[:1]):
             seg = pymunk.Segment(self.space.static_body, a, b, r)
             seg.friction = cfg.robot_friction
             self.space.add(seg)
+            walls.append(seg)
+        return walls
 
     def _add_ground_friction(self, body: pymunk.Body, force: float, torque: float) -> None:
         pivot = pymunk.PivotJoint(self.space.static_body, body, (0, 0), (0, 0))
