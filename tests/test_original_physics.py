@@ -9,6 +9,7 @@ import re
 import numpy as np
 import pytest
 
+from evolution.run.protocol import protocol_values
 from gathering_env.config import WorldConfig
 from gathering_env.contacts import mixing
 from gathering_env.simulation import GatheringSimulation
@@ -113,3 +114,15 @@ def test_mixing_gives_every_kind_of_contact_the_larger_restitution(values):
 def test_bad_physics_options_name_the_key_and_what_is_allowed(key, value, allowed):
     with pytest.raises(ValueError, match=rf"{key}=.*allowed: {re.escape(allowed)}"):
         WorldConfig.from_kwargs(1, **{key: value})
+
+
+@pytest.mark.usefixtures("both_kernels")
+def test_under_the_original_protocols_physics_one_robot_moves_a_medium_block_as_in_the_original():
+    # Measured on the original's own classes: 7.3 (fixed order) to 17.1 (its shuffled
+    # schedule) units in 500 steps; under the paper's world one robot cannot move it at all.
+    env = protocol_values("original")["environment"]
+    keys = ("ground_friction", "robot_restitution", "block_restitution", "wall_restitution",
+            "robot_drive_force", "robot_max_speed")
+    moved = push(1, steps=500, **{key: env[key] for key in keys})
+    assert 5.0 < moved < 25.0
+    assert push(1, steps=500) < 0.05

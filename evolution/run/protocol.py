@@ -25,6 +25,14 @@ key                           paper (default)     original
 ``[environment] zone_depth``  8                   4 (zone 20 x 4)
 ``[environment] pickup_box``  ``"front"``         ``"centre"``, 0.1 forward x 0.2 across
 ``[environment] ir_response`` ``"linear"``        ``"gamma"`` (the Khepera-like curve)
+``[environment]               ``"threshold"``     ``"mass"``: kinetic Coulomb friction 0.1 m g
+ground_friction``                                 whatever the robots needed (docs/fidelity.md)
+``[environment] robot_,       0, 0, 0             1, 0.4, 1 (Box2D's: a contact takes the larger)
+block_, wall_restitution``
+``[environment]               1.0, 0.5            3.63, 0.637: the original robot's net push at a
+robot_drive_force,                                standstill (5 from the wheels less its own
+robot_max_speed``                                 kinetic friction 1.37) and its top speed
+                                                  heading +y (measured on its own classes)
 ``[substrate] decode_window`` 1                   0.2 (middle 20 % of range, FOV, orientation)
 ``[substrate] bias_threshold`` false              true (biases thresholded like link weights)
 ============================  ==================  ================================================
@@ -46,7 +54,9 @@ from typing import Any
 ORIGINAL: dict[str, dict[str, Any]] = {
     "experiment": {"layout": "per_run", "elitism": "ratchet", "complexity": "original", "speciation": "original"},
     "environment": {"zone_depth": 4.0, "pickup_box": "centre", "pickup_box_width": 0.2, "pickup_box_depth": 0.1,
-                    "ir_response": "gamma"},
+                    "ir_response": "gamma", "ground_friction": "mass", "robot_restitution": 1.0,
+                    "block_restitution": 0.4, "wall_restitution": 1.0, "robot_drive_force": 3.63,
+                    "robot_max_speed": 0.637},
     "substrate": {"decode_window": 0.2, "bias_threshold": True},
 }
 
