@@ -23,7 +23,7 @@ from gathering_env.config import WorldConfig
 from gathering_env.simulation import GatheringSimulation
 
 PHYSICS_KEYS = ("ground_friction", "robot_restitution", "block_restitution", "wall_restitution",
-                "robot_drive_force", "robot_max_speed")
+                "robot_drive_force", "robot_max_speed", "drive_dead_band")
 START = (4.0, 2.0)
 """Where the pushed block starts: west of the zone, pushed north, 38 units from the far wall."""
 
@@ -31,6 +31,8 @@ START = (4.0, 2.0)
 ORIGINAL = {
     "free robot, full drive, heading +y": ("speed (units/s)", 0.637, 0.838),
     "free robot, full drive, heading +x": ("speed (units/s)", 0.256, 0.441),
+    "free robot, drive 0.5, heading +y": ("speed (units/s)", 0.196, 0.202),
+    "free robot, drive 0.3, heading +y": ("speed (units/s)", 0.0, 0.0665),
     "block sliding from 0.5 units/s": ("distance to rest", 0.098, 0.098),
     "1 robot, small block": ("moved in 500 steps", 22.7, 31.8),
     "1 robot, medium block": ("moved in 500 steps", 7.33, 17.1),
@@ -60,14 +62,14 @@ def simulation(world: str, block_type: int, robots: int) -> GatheringSimulation:
     return sim
 
 
-def free_drive(world: str, heading: float, steps: int = 300) -> float:
+def free_drive(world: str, heading: float, steps: int = 300, drive: float = 1.0) -> float:
     sim = simulation(world, 0, 1)
     sim.world.place_block(0, 35.0, 35.0, 0.0)
     sim.world.place_robot(0, 2.0, 2.0, heading)
     for _ in range(steps - 1):
-        sim.step(np.ones((1, 2)))
+        sim.step(np.full((1, 2), drive))
     before = sim.world.robot_pos[0].copy()
-    sim.step(np.ones((1, 2)))
+    sim.step(np.full((1, 2), drive))
     return float(np.hypot(*(sim.world.robot_pos[0] - before)) / sim.config.dt)
 
 
@@ -100,6 +102,8 @@ def measure(world: str) -> dict[str, float]:
     return {
         "free robot, full drive, heading +y": free_drive(world, math.pi / 2),
         "free robot, full drive, heading +x": free_drive(world, 0.0),
+        "free robot, drive 0.5, heading +y": free_drive(world, math.pi / 2, drive=0.5),
+        "free robot, drive 0.3, heading +y": free_drive(world, math.pi / 2, drive=0.3),
         "block sliding from 0.5 units/s": slide(world),
         "1 robot, small block": push(world, 0, 1),
         "1 robot, medium block": push(world, 1, 1),

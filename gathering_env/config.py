@@ -80,6 +80,9 @@ class WorldConfig:
     """Contact (Coulomb) friction of robot shapes."""
     robot_max_speed: float = 0.5
     """Top wheel speed (units/s); the robot's top speed when both wheels drive at 1."""
+    drive_dead_band: float = 0.0
+    """Wheel commands of magnitude up to this do nothing; above it a wheel's speed rises linearly
+    to top speed at 1 (the original robot: about 0.28, from its own ground friction). In [0, 1)."""
     robot_drive_force: float = 1.0
     """Maximum traction force a robot's wheels exert on the ground (force units)."""
     robot_drive_torque: float = 0.1
@@ -214,6 +217,7 @@ class WorldConfig:
             _check_float(name, getattr(self, name), 0.0, math.inf, low_open=True)
         for name in ("robot_friction", "block_friction", "time_bonus", "attach_reward"):
             _check_float(name, getattr(self, name), 0.0, math.inf)
+        _check_float("drive_dead_band", self.drive_dead_band, 0.0, 1.0, high_open=True)
         for name in ("robot_restitution", "block_restitution", "wall_restitution"):
             _check_float(name, getattr(self, name), 0.0, 1.0)
         _check_float("block_friction_margin", self.block_friction_margin, 0.0, 1.0,

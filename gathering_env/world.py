@@ -286,6 +286,7 @@ class GatheringWorld:
             wheels: (N, 2) left/right wheel commands in [-1, 1] (fraction of top speed).
         """
         cfg = self.config
+        wheels = dead_band(wheels, cfg.drive_dead_band)
         v_left = wheels[:, 0] * cfg.robot_max_speed
         v_right = wheels[:, 1] * cfg.robot_max_speed
         forward = 0.5 * (v_left + v_right)
@@ -412,6 +413,13 @@ class GatheringWorld:
             self.robot_attached[robot] = -1
         self.anchor_owner[block] = -1
         self.block_sticky_side[block] = -1
+
+
+def dead_band(wheels: np.ndarray, band: float) -> np.ndarray:
+    """Wheel commands after the drive's dead band: 0 up to ``band``, then linear to 1."""
+    if band == 0.0:
+        return wheels
+    return np.sign(wheels) * np.maximum(np.abs(wheels) - band, 0.0) / (1.0 - band)
 
 
 def _check_room(cfg: WorldConfig, radii: np.ndarray) -> None:

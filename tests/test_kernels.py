@@ -180,7 +180,10 @@ def _episode(kernel: str, steps: int, morphology: Morphology, seed: int, **world
     dict(environment=3, num_robots=20),
     dict(SMALL, pickup_box="centre", pickup_box_width=0.4, pickup_box_depth=0.4),
     dict(SMALL, pickup_box="centre", pickup_box_width=0.2, pickup_box_depth=0.1, zone_depth=4.0),
-], ids=["small", "avoidance", "weld-in-place", "gamma-substeps", "env3", "centre-box", "original-box"])
+    dict(SMALL, ground_friction="mass", robot_restitution=1.0, block_restitution=0.4, wall_restitution=1.0,
+         robot_drive_force=3.63, robot_max_speed=0.637, drive_dead_band=0.28),
+], ids=["small", "avoidance", "weld-in-place", "gamma-substeps", "env3", "centre-box", "original-box",
+        "original-physics"])
 def test_whole_episodes_are_identical_on_both_kernels(world):
     steps = 400
     attached = gathered = shared = False

@@ -122,7 +122,30 @@ def test_under_the_original_protocols_physics_one_robot_moves_a_medium_block_as_
     # schedule) units in 500 steps; under the paper's world one robot cannot move it at all.
     env = protocol_values("original")["environment"]
     keys = ("ground_friction", "robot_restitution", "block_restitution", "wall_restitution",
-            "robot_drive_force", "robot_max_speed")
+            "robot_drive_force", "robot_max_speed", "drive_dead_band")
     moved = push(1, steps=500, **{key: env[key] for key in keys})
     assert 5.0 < moved < 25.0
     assert push(1, steps=500) < 0.05
+
+
+def free_speed(drive: float, **overrides) -> float:
+    """Speed (units/s) of a lone robot after 30 steps at wheel drive (drive, drive)."""
+    sim = world((1, 0, 0), **overrides)
+    w = sim.world
+    w.place_block(0, 35.0, 35.0, 0.0)
+    w.place_robot(0, 5.0, 5.0, math.pi / 2)
+    for _ in range(30):
+        sim.step(np.full((1, 2), drive))
+    before = w.robot_pos[0].copy()
+    sim.step(np.full((1, 2), drive))
+    return float(np.hypot(*(w.robot_pos[0] - before)) / sim.config.dt)
+
+
+@pytest.mark.usefixtures("both_kernels")
+def test_dead_band_stops_weak_commands_and_scales_the_rest_to_top_speed():
+    band = dict(drive_dead_band=0.28, robot_max_speed=0.637)
+    assert free_speed(0.25, **band) == 0.0
+    assert free_speed(0.5, **band) == pytest.approx(0.637 * (0.5 - 0.28) / 0.72, rel=1e-3)  # original: 0.196
+    assert free_speed(-0.5, **band) == pytest.approx(0.637 * (0.5 - 0.28) / 0.72, rel=1e-3)
+    assert free_speed(1.0, **band) == pytest.approx(0.637, rel=1e-3)
+    assert free_speed(0.5, robot_max_speed=0.637) == pytest.approx(0.3185, rel=1e-3)         # no band

@@ -33,6 +33,8 @@ block_, wall_restitution``
 robot_drive_force,                                standstill (5 from the wheels less its own
 robot_max_speed``                                 kinetic friction 1.37) and its top speed
                                                   heading +y (measured on its own classes)
+``[environment]               0                   0.28: weaker wheel commands do nothing (the
+drive_dead_band``                                 original robot's own ground friction)
 ``[substrate] decode_window`` 1                   0.2 (middle 20 % of range, FOV, orientation)
 ``[substrate] bias_threshold`` false              true (biases thresholded like link weights)
 ============================  ==================  ================================================
@@ -56,7 +58,7 @@ ORIGINAL: dict[str, dict[str, Any]] = {
     "environment": {"zone_depth": 4.0, "pickup_box": "centre", "pickup_box_width": 0.2, "pickup_box_depth": 0.1,
                     "ir_response": "gamma", "ground_friction": "mass", "robot_restitution": 1.0,
                     "block_restitution": 0.4, "wall_restitution": 1.0, "robot_drive_force": 3.63,
-                    "robot_max_speed": 0.637},
+                    "robot_max_speed": 0.637, "drive_dead_band": 0.28},
     "substrate": {"decode_window": 0.2, "bias_threshold": True},
 }
 

@@ -36,7 +36,7 @@ T_TYPE, T_BEARING, T_OFFSET, T_RANGE, T_COS_HALF, T_SIN_HALF, T_INV_RANGE = rang
 # Entries of the float parameter vector (see ``world_params``).
 (P_RADIUS, P_ARENA_W, P_ARENA_H, P_ZX0, P_ZY0, P_ZX1, P_ZY1, P_FALLOFF, P_IR_GAMMA, P_DT,
  P_MAX_SPEED, P_ZONE_CX, P_ZONE_CY, P_AVOID_DIST, P_BOX_W, P_BOX_D, P_REACH, P_TOTAL_VALUE,
- P_MAX_CYCLES, P_BOX_OFFSET) = range(20)
+ P_MAX_CYCLES, P_BOX_OFFSET, P_DEAD_BAND) = range(21)
 # Entries of the integer flag vector.
 F_IR_GAMMA, F_AVOIDANCE, F_PICKUP = range(3)
 # Event kinds reported by ``settle`` (rows of the int event table: kind, world, robot, block, slot).
@@ -68,10 +68,20 @@ def world_params(config) -> tuple[np.ndarray, np.ndarray]:
         config.bottom_falloff, config.ir_gamma, config.dt, config.robot_max_speed, cx, cy,
         config.collision_avoidance_distance, config.pickup_box_width, config.pickup_box_depth,
         config.pickup_reach, config.total_value, config.max_cycles, config.pickup_box_offset,
+        config.drive_dead_band,
     ], dtype=np.float64)
     flags = np.array([config.ir_response == "gamma", config.collision_avoidance, config.pickup_heuristic],
                      dtype=np.int64)
     return params, flags
+
+
+@njit(cache=True)
+def _dead_band(command, band):
+    """A wheel command after the dead band (``WorldConfig.drive_dead_band``)."""
+    if band == 0.0:
+        return command
+    magnitude = max(abs(command) - band, 0.0) / (1.0 - band)
+    return magnitude if command >= 0.0 else -magnitude
 
 
 @njit(cache=True)
@@ -264,6 +274,7 @@ def drive(wheels, robot_pos, robot_angle, robot_attached, control_rows, raw, par
     n_rows = raw.shape[1]
     r = params[P_RADIUS]
     max_speed = params[P_MAX_SPEED]
+    band = params[P_DEAD_BAND]
     half_dt = 0.5 * params[P_DT]
     avoidance = flags[F_AVOIDANCE] != 0
     reach = r + params[P_AVOID_DIST]
@@ -321,8 +332,8 @@ def drive(wheels, robot_pos, robot_angle, robot_attached, control_rows, raw, par
             vel[w, row, 1] = raw[w, row, 4]
             vel[w, row, 2] = raw[w, row, 5]
         for i in range(n):
-            v_left = left[i] * max_speed
-            v_right = right[i] * max_speed
+            v_left = _dead_band(left[i], band) * max_speed
+            v_right = _dead_band(right[i], band) * max_speed
             forward = 0.5 * (v_left + v_right)
             spin = (v_right - v_left) / (2.0 * r)
             heading = robot_angle[w, i] + half_dt * spin
