@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import importlib.util
 import itertools
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -149,3 +151,17 @@ def test_dead_band_stops_weak_commands_and_scales_the_rest_to_top_speed():
     assert free_speed(-0.5, **band) == pytest.approx(0.637 * (0.5 - 0.28) / 0.72, rel=1e-3)
     assert free_speed(1.0, **band) == pytest.approx(0.637, rel=1e-3)
     assert free_speed(0.5, robot_max_speed=0.637) == pytest.approx(0.3185, rel=1e-3)         # no band
+
+
+def test_the_fidelity_pages_pushing_table_is_what_the_scenes_measure_today():
+    # docs/fidelity.md quotes examples/physics_scenes.py; a change of the world or the bundle
+    # that moves a figure must update the page (python examples/physics_scenes.py prints it).
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("physics_scenes", root / "examples" / "physics_scenes.py")
+    scenes = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(scenes)
+    page = (root / "docs" / "fidelity.md").read_text()
+    for world, column in (("original", 3), ("paper", 4)):
+        for scene, value in scenes.measure(world).items():
+            row = next(line for line in page.splitlines() if line.startswith(f"| {scene} |"))
+            assert row.split("|")[1 + column].strip() == f"{value:.3g}", (world, scene)
