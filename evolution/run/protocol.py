@@ -68,7 +68,8 @@ PROTOCOLS = ("paper", "original")
 DESCRIPTIONS = {
     "paper": "the paper's text (the defaults)",
     "original": "the 2018 Java code that produced the published figures: one layout per run, ratchet on the best "
-                "genome, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its eq. 2",
+                "genome, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its eq. 2, its "
+                "physics (mass friction, bouncing contacts, its robot's push, speed and dead band)",
 }
 
 
