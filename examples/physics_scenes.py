@@ -13,17 +13,15 @@ restitution, the original robot's push and top speed).
 
 from __future__ import annotations
 
-import argparse
 import math
 
 import numpy as np
 
-from evolution.run.protocol import protocol_values
+from evolution.guard import ArgumentParser, command
+from evolution.run.protocol import ORIGINAL_PHYSICS, protocol_values
 from gathering_env.config import WorldConfig
 from gathering_env.simulation import GatheringSimulation
 
-PHYSICS_KEYS = ("ground_friction", "robot_restitution", "block_restitution", "wall_restitution",
-                "robot_drive_force", "robot_max_speed", "drive_dead_band")
 START = (4.0, 2.0)
 """Where the pushed block starts: west of the zone, pushed north, 38 units from the far wall."""
 
@@ -48,7 +46,7 @@ def physics(world: str) -> dict:
     keys = {}
     if world == "original":
         env = protocol_values("original")["environment"]
-        keys = {key: env[key] for key in PHYSICS_KEYS}
+        keys = {key: env[key] for key in ORIGINAL_PHYSICS}
     return keys
 
 
@@ -114,8 +112,9 @@ def measure(world: str) -> dict[str, float]:
     }
 
 
+@command
 def main(argv: list[str] | None = None) -> int:
-    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args(argv)
+    ArgumentParser(description=__doc__.splitlines()[0]).parse_args(argv)
     ours = {world: measure(world) for world in ("paper", "original")}
     print("| scene | measured | original (fixed order / shuffled) | here, original protocol | here, paper |")
     print("|---|---|---|---|---|")

@@ -104,7 +104,7 @@ class WorldConfig:
     """Blocks' friction with the floor: 'threshold' (a block needing k robots resists with
     (k - block_friction_margin) * robot_drive_force, so k - 1 robots cannot move it and k can)
     or 'mass' (the original code: kinetic Coulomb friction 0.1 * m * g, torque 0.01 * m * g,
-    whatever the robots needed; ``gathering_env.ground``)."""
+    whatever the robots needed; ``block_ground_friction``)."""
     robot_restitution: float = 0.0
     """Restitution (bounciness) of robots; a contact takes the larger of its two shapes' (as
     Box2D does). 0: contacts absorb the approach speed; the original code: 1 (fully elastic)."""

@@ -41,8 +41,9 @@ def mixing(config: WorldConfig) -> tuple[dict[str, float], list[tuple[str, str, 
     best: tuple[int, dict[str, float], list] | None = None
     for ones in itertools.product((False, True), repeat=len(e)):
         x = {kind: 1.0 if one else e[kind] for kind, one in zip(e, ones)}
-        left = [(a, b, max(e[a], e[b])) for a, b, _ in _PAIRS if x[a] * x[b] != max(e[a], e[b])]
-        cost = sum(w for a, b, w in _PAIRS if x[a] * x[b] != max(e[a], e[b]))
+        wrong = [(a, b, w) for a, b, w in _PAIRS if x[a] * x[b] != max(e[a], e[b])]
+        left = [(a, b, max(e[a], e[b])) for a, b, _ in wrong]
+        cost = sum(w for _, _, w in wrong)
         if best is None or cost < best[0]:
             best = (cost, x, left)
     return best[1], best[2]

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from evolution.run.protocol import protocol_values
+from evolution.run.protocol import ORIGINAL_PHYSICS, protocol_values
 from gathering_env.config import WorldConfig
 from gathering_env.contacts import mixing
 from gathering_env.simulation import GatheringSimulation
@@ -123,9 +123,7 @@ def test_under_the_original_protocols_physics_one_robot_moves_a_medium_block_as_
     # Measured on the original's own classes: 7.3 (fixed order) to 17.1 (its shuffled
     # schedule) units in 500 steps; under the paper's world one robot cannot move it at all.
     env = protocol_values("original")["environment"]
-    keys = ("ground_friction", "robot_restitution", "block_restitution", "wall_restitution",
-            "robot_drive_force", "robot_max_speed", "drive_dead_band")
-    moved = push(1, steps=500, **{key: env[key] for key in keys})
+    moved = push(1, steps=500, **{key: env[key] for key in ORIGINAL_PHYSICS})
     assert 5.0 < moved < 25.0
     assert push(1, steps=500) < 0.05
 

@@ -62,6 +62,11 @@ ORIGINAL: dict[str, dict[str, Any]] = {
     "substrate": {"decode_window": 0.2, "bias_threshold": True},
 }
 
+#: The world keys of the bundle that are physics (friction, restitution, drive), for scenes
+#: that compare the original's pushing with this simulator's (examples/physics_scenes.py).
+ORIGINAL_PHYSICS = ("ground_friction", "robot_restitution", "block_restitution", "wall_restitution",
+                    "robot_drive_force", "robot_max_speed", "drive_dead_band")
+
 PROTOCOLS = ("paper", "original")
 
 #: One line per protocol, for ``gathering-evolve --list``.
@@ -125,4 +130,4 @@ def apply_protocol(name: str, sections: dict[str, dict[str, Any]], source: str,
             target[key] = list(value) if isinstance(value, list) else value
 
 
-__all__ = ["DESCRIPTIONS", "ORIGINAL", "PROTOCOLS", "apply_protocol", "protocol_values"]
+__all__ = ["DESCRIPTIONS", "ORIGINAL", "ORIGINAL_PHYSICS", "PROTOCOLS", "apply_protocol", "protocol_values"]
