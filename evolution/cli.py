@@ -76,6 +76,10 @@ def evolve_main(argv: list[str] | None = None) -> int:
                              "an experiment file the run's own experiment is used")
     parser.add_argument("--resume-from", type=Path, metavar="CHECKPOINT",
                         help="continue from this checkpoint, in its run directory or into a new --out")
+    parser.add_argument("--rebuild-from", type=Path, metavar="RECORD",
+                        help="a new run of the same experiment that takes the scores of the generations recorded "
+                             "in RECORD (a run or evidence folder) instead of simulating them, then goes on "
+                             "(docs/evolution.md, 'Rebuilding a run')")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--backend", choices=("serial", "process", "ray"), default="process",
                         help="where genomes are evaluated (default: process pool)")
@@ -149,6 +153,11 @@ def evolve_main(argv: list[str] | None = None) -> int:
         raise UsageError("--resume: which run? allowed: --resume RUN_DIR")
     if resume and args.experiment is None:
         experiment = None  # the run's own experiment, from its checkpoint
+    elif args.rebuild_from is not None and args.experiment is None:
+        from evolution.run.rebuild import experiment_of_record
+
+        experiment = experiment_of_record(args.rebuild_from, overrides)  # the record's own experiment
+        out = out or Path("runs") / f"{experiment.name}-seed{experiment.seed}"
     else:
         experiment = load_experiment(args.experiment, overrides)
         out = out or Path("runs") / f"{experiment.name}-seed{experiment.seed}"
@@ -157,7 +166,7 @@ def evolve_main(argv: list[str] | None = None) -> int:
     trainer = Trainer(experiment, out, workers=args.workers, resume=resume,
                       resume_from=args.resume_from, progress=not args.no_progress,
                       backend=args.backend, ray_address=args.ray_address, max_retries=args.max_retries,
-                      overrides=overrides)
+                      overrides=overrides, rebuild_from=args.rebuild_from)
     try:
         result = trainer.run()
     except KeyboardInterrupt:

@@ -154,14 +154,19 @@ def evaluate(genome: Any, config: Any, env_config: dict[str, Any], trials: int =
     seeds = episode_seeds(seed, generation, trials, layout)
     sims = _worlds_for(env_config, len(seeds))
     fts, total_steps, t_env, t_ctrl = run_trials(sims, controller, morphology, seeds)
+    return scored(controller, morphology, fts, complexity, steps=total_steps, seconds_env=t_env,
+                  seconds_controller=t_ctrl, seconds_decode=t_decode)
+
+
+def scored(controller, morphology: Morphology, fts, complexity: str = "paper", **work: Any) -> Evaluation:
+    """The ``Evaluation`` of a decoded genome whose trials scored ``fts``: the task objective is
+    their mean; the others, and the sensor statistics, follow from the decoded genome.
+    ``work``: ``steps`` and the ``seconds_*`` of the evaluation."""
     return Evaluation(
         task=float(np.mean(fts)),
         morphology=morphological_complexity(morphology, complexity),
         controller=100.0 - float(controller.num_links),
         trial_ft=[float(f) for f in fts],
         sensors=sensor_statistics(morphology),
-        steps=total_steps,
-        seconds_env=t_env,
-        seconds_controller=t_ctrl,
-        seconds_decode=t_decode,
+        **work,
     )

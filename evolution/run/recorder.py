@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import random
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -96,24 +97,31 @@ class RunRecorder:
     # ------------------------------------------------------------------ generations
     def record(self, population: neat.Population, generation: int, species_count: int, seconds: float,
                evaluations: dict[int, Evaluation], genomes: dict[int, Any], failures: int,
-               threshold: float | None = None) -> dict[str, Any]:
+               threshold: float | None = None, carried: frozenset[int] = frozenset(),
+               amend: Callable[[dict[str, Any]], dict[str, Any]] | None = None) -> dict[str, Any]:
         """Keep and append the statistics of a finished generation (``species`` and the
-        compatibility ``threshold`` that formed them); a better genome becomes the champion."""
+        compatibility ``threshold`` that formed them); a better genome becomes the champion.
+        ``carried``: genomes entered with their stored evaluation (not scored this generation).
+        ``amend``: checks and completes the record before it is kept (a rebuilt generation,
+        ``evolution.run.rebuild``)."""
         best_key = max(evaluations, key=lambda k: (evaluations[k].task, -k))
         record = generation_record(generation, list(evaluations.values()), species_count, seconds, best_key)
         record["threshold"] = None if threshold is None else float(threshold)
         record["failures"] = int(failures)
+        record["trial_ft"] = trial_scores(evaluations, carried)
+        exp = self.experiment
+        if exp.multi_objective:
+            front = population.reproduction.front
+            record["front"] = {"genomes": [k for k, _ in front], "objectives": [list(o) for _, o in front],
+                               "names": list(exp.objectives)}
+        if amend is not None:
+            record = amend(record)
         best_task = evaluations[best_key].task
         if self.best is None or best_task > self.best[0]:
             self.best = (best_task, best_key)
             self.champion_state = {"generation": generation, "genome": genomes[best_key],
                                    "evaluation": evaluations[best_key]}
             self.write_champion(**self.champion_state)
-        exp = self.experiment
-        if exp.multi_objective:
-            front = population.reproduction.front
-            record["front"] = {"genomes": [k for k, _ in front], "objectives": [list(o) for _, o in front],
-                               "names": list(exp.objectives)}
         self.records.append(record)
         append_stats(self.stats_path, record)
         return record
@@ -159,9 +167,18 @@ class RunRecorder:
             plot_run(self.records, self.run_dir / "stats.png", title=self.experiment.name)
 
 
+def trial_scores(evaluations: dict[int, Evaluation], carried: frozenset[int] = frozenset()
+                 ) -> dict[str, list[float] | None]:
+    """The record's ``trial_ft``: each genome scored this generation (id as a string) with its
+    trials' ft, or None for a failed evaluation; ``carried`` genomes are left out. Everything
+    else about an evaluation follows from the genome (``evolution.run.replay``)."""
+    return {str(key): None if ev.failed else [float(f) for f in ev.trial_ft]
+            for key, ev in sorted(evaluations.items()) if key not in carried}
+
+
 def convergence_target(experiment: Experiment) -> float:
     """ft of a team that gathers every block within half the allowed steps: 100 + bonus / 2."""
     return 100.0 + experiment.world_config().time_bonus / 2.0
 
 
-__all__ = ["CHECKPOINT_DIR", "KEEP_CHECKPOINTS", "RunRecorder", "checkpoints_in", "convergence_target"]
+__all__ = ["CHECKPOINT_DIR", "KEEP_CHECKPOINTS", "RunRecorder", "checkpoints_in", "convergence_target", "trial_scores"]

@@ -35,6 +35,7 @@ from evolution.run.backends import EvalContext, make_evaluator
 from evolution.run.evaluate import Evaluation
 from evolution.run.experiment import Experiment
 from evolution.run.lock import RunLock
+from evolution.run.rebuild import RebuildingEvaluator, load_record
 from evolution.run.recorder import RunRecorder, convergence_target
 from evolution.run.rundir import check_new_run_dir, new_run, restore_run
 from gathering_env.compiled.engine import announce_compile
@@ -86,6 +87,8 @@ class Trainer:
             Ray cluster instead of starting a local one. max_retries: per failing evaluation.
         overrides: as for ``load_experiment``, applied to the run's experiment when
             ``experiment`` is None (only ``generations`` and ``name`` may differ from the run).
+        rebuild_from: a new run takes the scores of the generations recorded there (a run or
+            evidence folder) instead of simulating them (``evolution.run.rebuild``).
 
     Output folder: the rules of ``evolution.run.rundir`` (a new run into a missing or empty
     folder; a resumed run verified before anything is written; one writer at a time, by the
@@ -100,9 +103,13 @@ class Trainer:
     def __init__(self, experiment: Experiment | None, run_dir: Path, workers: int | None = None,
                  resume: bool = False, resume_from: Path | None = None, progress: bool = True,
                  backend: str = "process", ray_address: str | None = None, max_retries: int = 2,
-                 overrides: dict[str, Any] | None = None) -> None:
+                 overrides: dict[str, Any] | None = None, rebuild_from: Path | None = None) -> None:
         if experiment is None and not (resume or resume_from is not None):
             raise ValueError("experiment=None needs resume=True (the run's own experiment)")
+        if rebuild_from is not None and (resume or resume_from is not None or experiment is None):
+            raise UsageError(f"--rebuild-from {rebuild_from}: starts a new run from a record; allowed: an experiment "
+                             "and a new --out, without --resume (a run with checkpoints resumes from them)")
+        self.rebuild_from = Path(rebuild_from) if rebuild_from is not None else None
         self.experiment = experiment
         self.run_dir = Path(run_dir)
         self.workers = workers
@@ -117,6 +124,7 @@ class Trainer:
         self.recorder: RunRecorder | None = None
         self._current: dict[int, Evaluation] = {}
         self._current_genomes: dict[int, Any] = {}
+        self._carried: frozenset[int] = frozenset()
         self._failures = 0
 
     @property
@@ -163,6 +171,7 @@ class Trainer:
                 recorder.plot()
             return self._result(recorder.converged(), already_finished=True)
         converged = False
+        recorded = load_record(self.rebuild_from, exp.to_dict()) if self.rebuild_from is not None else None
         context = EvalContext(recorder.config, dict(exp.environment), exp.trials, exp.seed, exp.method,
                               recorder.substrate, layout=exp.layout, complexity=exp.complexity)
         for line in protocol_notes(exp):
@@ -175,6 +184,10 @@ class Trainer:
         evaluator = self._evaluator = make_evaluator(context, self.workers, self.backend, self.ray_address,
                                                      self.max_retries)
         random.setstate(random_state)
+        if recorded is not None:
+            evaluator = self._evaluator = RebuildingEvaluator(evaluator, recorded, context, self.rebuild_from)
+            print(f"{exp.name}: generations 0-{len(recorded) - 1} rebuilt from {self.rebuild_from} (its recorded "
+                  "scores, each generation checked against its record), the rest simulated", flush=True)
         try:  # nothing is written before the backend is up and the run directory is locked
             lock.acquire()
             write()
@@ -197,10 +210,13 @@ class Trainer:
 
                 self._generation = generation
                 self._population = population
+                rebuilt = isinstance(evaluator, RebuildingEvaluator) and evaluator.rebuilds(generation)
+                amend = evaluator.check if rebuilt else None
                 population.run(self._fitness, 1)
                 self._check_run_dir(generation)
                 record = recorder.record(population, generation, species_count, time.perf_counter() - start,
-                                         self._current, self._current_genomes, self._failures, threshold)
+                                         self._current, self._current_genomes, self._failures, threshold,
+                                         self._carried, amend)
                 recorder.save_checkpoint(population)
                 if bar is not None:
                     bar.set_postfix(best_ft=f"{record['task_best']:.1f}", mean_ft=f"{record['task_mean']:.1f}")
@@ -302,3 +318,4 @@ class Trainer:
             self._current[key] = replace(g.evaluation, steps=0, seconds_env=0.0, seconds_controller=0.0,
                                          seconds_decode=0.0)
         self._current_genomes = dict(genomes) | kept
+        self._carried = frozenset(kept)
