@@ -119,8 +119,16 @@ def unseen_note(champion: Champion, env_config: dict[str, Any], seed: int) -> st
     trained = champion.objectives.get("task")
     if trained is None:
         return f"an unseen episode (seed {seed}): the champion file holds no training ft to compare with"
-    changed = [key for key in ("environment", "max_cycles", "num_robots")
-               if key in env_config and env_config[key] != champion.environment.get(key, env_config[key])]
+    changed = [key for key in sorted(set(env_config) | set(champion.environment))
+               if env_config.get(key) != champion.environment.get(key)]
+    own = champion.trial_seeds
+    if seed in own and not changed:
+        if len(own) == 1:
+            return (f"its training episode (seed {seed}, the run's one layout): the simulation is deterministic, "
+                    f"so ft equals the training ft {trained:.2f}")
+        return (f"one of its {len(own)} training episodes (seed {seed}): ft is that trial's score; the training "
+                f"ft {trained:.2f} is the mean over all {len(own)}")
     world = f" in a changed world ({', '.join(changed)})" if changed else ""
+    layout = f" (its training layout is --seed {own[0]})" if len(own) == 1 and not changed else ""
     return (f"an unseen episode (seed {seed}){world}: the training ft {trained:.2f} is the mean over the "
-            f"run's own trial episodes; one new episode can score far from it")
+            f"run's own trial episodes{layout}; one new episode can score far from it")

@@ -96,3 +96,29 @@ def test_replay_says_its_episode_is_unseen_and_quotes_the_training_ft(champion, 
                         "episodes; one new episode can score far from it")
     assert replay_main([str(champion), "--steps", "20", "--out", str(tmp_path / "u.gif")]) == 0
     assert "an unseen episode (seed 0) in a changed world (max_cycles): " in capsys.readouterr().out
+
+
+def test_a_per_run_champion_replayed_on_its_layout_scores_its_training_ft(tmp_path, capsys):
+    """The champion records its training episodes (``trial_seeds``): replayed on the run's one
+    layout it scores exactly its training ft (the simulation is deterministic), and the note
+    says which episode it is; any other seed is unseen and the note names the training layout."""
+    from small_runs import evolve, experiment_file
+
+    from evolution.run.champion import load_champion
+    from evolution.run.evaluate import trial_seed
+
+    exp = experiment_file(tmp_path, "perrun", "hyperneat-m", '["task"]', generations=2,
+                          extra='layout = "per_run"\nelitism = "ratchet"')
+    evolve(exp, tmp_path / "run")
+    champ = load_champion(tmp_path / "run" / "champion.json")
+    layout = trial_seed(3, 0, 0)
+    assert champ.trial_seeds == (layout,)
+    assert champ.objectives["task"] > 0  # a score a wrong episode would not reproduce by chance
+    capsys.readouterr()
+    assert replay_main([str(tmp_path / "run" / "champion.json"), "--seed", str(layout),
+                        "--out", str(tmp_path / "own.gif")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert f"ft = {champ.objectives['task']:.2f}" in lines[0]
+    assert lines[1].startswith(f"its training episode (seed {layout}, the run's one layout)")
+    assert replay_main([str(tmp_path / "run" / "champion.json"), "--out", str(tmp_path / "new.gif")]) == 0
+    assert f"(its training layout is --seed {layout})" in capsys.readouterr().out

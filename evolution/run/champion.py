@@ -111,12 +111,15 @@ class Champion:
     generation: int = -1
     genome_key: int = -1
     genome: dict[str, Any] | None = None
+    trial_seeds: tuple[int, ...] = ()
+    """The episodes of ``objectives['task']`` (empty: not recorded, e.g. a file of an older run)."""
 
 
 def save_champion(path: Path, *, method: str, experiment: str, generation: int, genome: Any,
                   morphology: Morphology, controller: Any, objectives: dict[str, float],
-                  environment: dict[str, Any]) -> Path:
-    """Write a champion JSON file atomically; returns its path."""
+                  environment: dict[str, Any], trial_seeds: list[int] | None = None) -> Path:
+    """Write a champion JSON file atomically; returns its path. ``trial_seeds``: the episodes
+    its ``task`` objective is the mean ft over (``evolution.run.evaluate.episode_seeds``)."""
     doc = {
         "format": FORMAT,
         "version": VERSION,
@@ -130,6 +133,8 @@ def save_champion(path: Path, *, method: str, experiment: str, generation: int, 
         "controller": controller.to_dict(),
         "genome": genome_to_dict(genome),
     }
+    if trial_seeds is not None:
+        doc["trial_seeds"] = [int(s) for s in trial_seeds]
     path = Path(path)
     atomic_write_bytes(path, (json.dumps(doc, indent=1, allow_nan=False) + "\n").encode())
     return path
@@ -166,6 +171,11 @@ def load_champion(path: str | Path) -> Champion:
         controller = TeamController.from_dict(doc["controller"])
     except (ValueError, KeyError, TypeError, AttributeError, IndexError) as err:
         raise ChampionError(f"{path}: field 'controller': {err!s}") from None
+    seeds = doc.get("trial_seeds", [])
+    if not isinstance(seeds, list) or not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0
+                                               for s in seeds):
+        raise ChampionError(f"{path}: field 'trial_seeds' is {seeds!r}; allowed: a list of episode seeds "
+                            "(integers >= 0)")
     if controller.num_inputs != len(morphology):
         raise ChampionError(f"{path}: field 'controller' reads {controller.num_inputs} inputs but the morphology "
                             f"has {len(morphology)} sensors; allowed: one input per sensor")
@@ -173,7 +183,7 @@ def load_champion(path: str | Path) -> Champion:
         method=str(doc["method"]), morphology=morphology, controller=controller,
         objectives=objectives, environment=dict(doc["environment"]),
         experiment=str(doc.get("experiment", "")), generation=doc.get("generation", -1),
-        genome_key=doc.get("genome_key", -1), genome=doc.get("genome"),
+        genome_key=doc.get("genome_key", -1), genome=doc.get("genome"), trial_seeds=tuple(seeds),
     )
 
 
