@@ -32,6 +32,7 @@ import pymunk.batch as pbatch
 
 from .config import WorldConfig
 from .contacts import apply_restitution
+from .placement import check_placement, lay_out
 
 _VEL = pbatch.BodyFields.VELOCITY | pbatch.BodyFields.ANGULAR_VELOCITY
 _STATE = pbatch.BodyFields.POSITION | pbatch.BodyFields.ANGLE | _VEL
@@ -40,13 +41,6 @@ STATE_ARRAYS = ("robot_pos", "robot_angle", "block_pos", "block_angle", "robot_a
                 "block_sticky_side", "anchor_owner", "raw")
 """The per-world arrays a batch may own (see ``adopt``)."""
 _WALL_RADIUS = 0.5
-_PLACEMENT_GAP = 0.05
-"""Clearance (units) between objects laid out at reset."""
-_PLACEMENT_ATTEMPTS = 10_000
-"""Random positions tried per object; all objects together get this many per 10 objects."""
-_MAX_COVER = 0.45
-"""Largest fraction of the floor outside the zone that objects (with clearance) may cover."""
-
 # Block sides in the block frame: outward normal and tangent of side 0..3 (E, N, W, S).
 _SIDE_NORMALS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
 _SIDE_TANGENTS = np.array([[0.0, 1.0], [-1.0, 0.0], [0.0, -1.0], [1.0, 0.0]])
@@ -97,7 +91,7 @@ class GatheringWorld:
         self.block_half = 0.5 * np.asarray(cfg.block_sizes, dtype=float)[types]
         self.block_need = np.asarray(cfg.robots_needed, dtype=np.int64)[types]
         self.block_value = np.asarray(cfg.block_values, dtype=float)[types]
-        block_xy, robot_xy = self._place(rng)
+        block_xy, robot_xy = lay_out(cfg, self.block_half, rng)
         block_angles = rng.uniform(-math.pi, math.pi, size=len(types))
         robot_angles = rng.uniform(-math.pi, math.pi, size=cfg.num_robots)
 
@@ -191,54 +185,11 @@ class GatheringWorld:
         gear.max_force = torque
         self.space.add(pivot, gear)
 
-    def _place(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        """Random non-overlapping positions outside the zone: blocks first, then robots."""
-        cfg = self.config
-        radii = np.concatenate([
-            self.block_half * math.sqrt(2.0),
-            np.full(cfg.num_robots, cfg.robot_radius),
-        ])
-        zx0, zy0, zx1, zy1 = cfg.zone_rect
-        placed = np.zeros((len(radii), 2))
-        gap = _PLACEMENT_GAP
-        _check_room(cfg, radii)
-        budget = _PLACEMENT_ATTEMPTS * (1 + len(radii) // 10)  # all objects together
-        for i, rad in enumerate(radii):
-            margin = rad + gap
-            for _attempt in range(min(_PLACEMENT_ATTEMPTS, budget)):
-                budget -= 1
-                x = rng.uniform(margin, cfg.arena_width - margin)
-                y = rng.uniform(margin, cfg.arena_height - margin)
-                # keep the whole object outside the zone
-                dx = max(zx0 - x, 0.0, x - zx1)
-                dy = max(zy0 - y, 0.0, y - zy1)
-                if math.hypot(dx, dy) <= margin:
-                    continue
-                if i and np.any(np.hypot(placed[:i, 0] - x, placed[:i, 1] - y) < radii[:i] + margin):
-                    continue
-                placed[i] = (x, y)
-                break
-            else:
-                raise ValueError(
-                    f"could not place all robots and blocks without overlap (gave up at object {i + 1} of "
-                    f"{len(radii)}): the arena "
-                    f"({cfg.arena_width} x {cfg.arena_height}) is too small for "
-                    f"{cfg.num_robots} robots and block_counts={cfg.block_counts}"
-                )
-        nb = len(self.block_half)
-        return placed[:nb], placed[nb:]
-
     @classmethod
     def check_placement(cls, config: WorldConfig, seed: int = 0) -> None:
-        """Raise ``ValueError`` unless the robots and blocks of ``config`` can be laid out once.
-
-        Worlds that cannot work (a block wider than the arena, more object area than free
-        floor) fail at once; crowded ones fail within a bounded number of attempts.
-        """
-        world = cls(config)
-        types = np.repeat(np.arange(3), config.block_counts)
-        world.block_half = 0.5 * np.asarray(config.block_sizes, dtype=float)[types]
-        world._place(np.random.default_rng(seed))
+        """Raise ``ValueError`` unless the robots and blocks of ``config`` can be laid out once
+        (``gathering_env.placement.check_placement``)."""
+        check_placement(config, seed)
 
     def _index_bodies(self) -> None:
         """Row of every robot, block and control body in pymunk's batch arrays."""
@@ -420,28 +371,3 @@ def dead_band(wheels: np.ndarray, band: float) -> np.ndarray:
     if band == 0.0:
         return wheels
     return np.sign(wheels) * np.maximum(np.abs(wheels) - band, 0.0) / (1.0 - band)
-
-
-def _check_room(cfg: WorldConfig, radii: np.ndarray) -> None:
-    """Raise ``ValueError`` for worlds whose objects certainly cannot be laid out."""
-    if not len(radii):
-        return
-    margin = float(radii.max()) + _PLACEMENT_GAP
-    zx0, zy0, zx1, zy1 = cfg.zone_rect
-    room = f"the arena ({cfg.arena_width} x {cfg.arena_height}, zone {cfg.zone_width} x {cfg.zone_depth})"
-    if 2 * margin >= cfg.arena_width or 2 * margin >= cfg.arena_height:
-        raise ValueError(f"block_sizes={cfg.block_sizes}: an object of radius {margin - _PLACEMENT_GAP:.3g} does "
-                         f"not fit into {room}; allowed: objects smaller than the arena")
-    # Outside the zone: above it, or beside it if the zone leaves room at the sides.
-    above = cfg.arena_height - margin > zy1 + margin
-    beside = zx0 - margin > margin
-    if not (above or beside):
-        raise ValueError(f"block_sizes={cfg.block_sizes}: no room outside the gathering zone in {room} for an "
-                         f"object of radius {margin - _PLACEMENT_GAP:.3g}; allowed: smaller objects or zone")
-    free = cfg.arena_width * cfg.arena_height - cfg.zone_width * cfg.zone_depth
-    need = float(np.sum(math.pi * (radii + 0.5 * _PLACEMENT_GAP) ** 2))
-    if need > _MAX_COVER * free:
-        raise ValueError(
-            f"num_robots={cfg.num_robots}, block_counts={cfg.block_counts}: the robots and blocks would cover "
-            f"{need / free:.0%} of the free floor of {room}; allowed: at most {_MAX_COVER:.0%} (random "
-            "placement jams near 55 %): fewer or smaller objects, or a larger arena")

@@ -312,7 +312,8 @@ def test_world_check_by_hand():
     (88 square units free). Robot pi 0.175^2 = 0.096211, block pi 0.307843^2 = 0.297720:
     0.45 * 88 = 39.6 allows (39.6 - 0.29772) / 0.096211 = 408.5 robots."""
     from gathering_env.config import WorldConfig
-    from gathering_env.world import GatheringWorld, _check_room
+    from gathering_env.placement import check_room as _check_room
+    from gathering_env.world import GatheringWorld
 
     small = dict(environment=None, arena_width=10.0, arena_height=10.0, zone_width=6.0, zone_depth=2.0,
                  block_counts=(1, 0, 0))
