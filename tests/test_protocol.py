@@ -555,3 +555,40 @@ def test_the_ratchets_species_survives_a_tie_with_a_younger_genome():
     species_set.speciate(config, new, 1)
     assert sid in species_set.species
     assert species_set.species[sid].representative.key == founder
+
+
+def _two_stagnant_species(top_in_second: float):
+    """Generation 30 of Encog's selection with the ratchet: species A (the older) holds the best
+    genome (50, the first to score it), species B's best scores ``top_in_second``; neither
+    improved since generation 0."""
+    import neat
+
+    config, population, _ = _population_of_one_species(20, {"speciation": "original", "elitism": "ratchet"})
+    species_set = population.species
+    (old,) = species_set.species.values()
+    keys = sorted(old.members)
+    members = {k: old.members[k] for k in keys}
+    for g in members.values():
+        g.fitness = 1.0
+    members[keys[3]].fitness = 50.0
+    members[keys[15]].fitness = top_in_second
+    a, b = neat.species.Species(1, 0), neat.species.Species(2, 0)
+    a.update(members[keys[3]], {k: members[k] for k in keys[:10]})
+    b.update(members[keys[15]], {k: members[k] for k in keys[10:]})
+    for s in (a, b):
+        s.fitness_history, s.last_improved = [max(s.get_fitnesses())] * 30, 0
+    species_set.species = {1: a, 2: b}
+    return config, population, keys[3]
+
+
+def test_encogs_stagnation_spares_the_best_genomes_species_only():
+    """Encog removes a species after 15 generations without improvement, except the species of
+    the best genome (``removeSpecies``): with the ratchet's best in the older species A and species
+    B tying it, A lives on and B is removed. (neat-python's ``species_elitism = 1`` spares the
+    fittest species, and of two that tie the one with the later id: B, and A died.)"""
+    config, population, best = _two_stagnant_species(50.0)
+    assert config.stagnation_config.species_elitism == 0
+    new = population.reproduction.reproduce(config, population.species, 20, 30)
+    assert population.reproduction.best.key == best
+    assert set(population.species.species) == {1}
+    assert len(new) == 20 and best in new

@@ -215,8 +215,10 @@ def breed(candidates: list[int], genomes: dict[int, Any], score: dict[int, float
 #: ``[NEATReproduction] original_elite_rate`` overrides it.
 ORIGINAL_ELITE_RATE, ORIGINAL_ELITE_MIN_MEMBERS = 0.0, 5
 #: Encog's stagnation in its speciation: a species is removed after more than 15 generations
-#: without improvement (neat-python's ``max_stagnation`` counts to 16), except the best species.
-ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM = 16, 1
+#: without improvement (neat-python's ``max_stagnation`` counts to 16), except the species of the
+#: best genome (``ThresholdSpeciation.removeSpecies``), whatever the other species score: so no
+#: species is spared for its fitness (``species_elitism`` 0) and ``NEATReproduction`` spares that one.
+ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM = 16, 0
 
 
 def original_leader(members: dict[int, Any], incumbent: int) -> int:
@@ -336,7 +338,9 @@ class NEATReproduction(neat.DefaultReproduction):
                         self.best = g
         self.carried = set()
         remaining, fitnesses = [], []
+        spared = self._best_species(species, ratchet)
         for sid, s, stagnant in self.stagnation.update(species, generation):
+            stagnant = stagnant and sid != spared
             if stagnant:
                 self.reporters.species_stagnant(sid, s)
             else:
@@ -381,6 +385,20 @@ class NEATReproduction(neat.DefaultReproduction):
                                         self.ancestors))
         return new_population
 
+    def _best_species(self, species: Any, ratchet: bool) -> int | None:
+        """With Encog's selection, the species that stagnation never removes: the one holding the
+        best genome (``_best_key``); None with neat-python's selection (its ``species_elitism``
+        spares the fittest species)."""
+        if not getattr(species.species_set_config, "leaders", False):
+            return None
+        holder = {k: sid for sid, s in species.species.items() for k in s.members}
+        fitness = {k: g.fitness for s in species.species.values() for k, g in s.members.items()}
+        return holder.get(self._best_key(fitness, ratchet)) if fitness else None
+
+    def _best_key(self, fitness: dict[int, float], ratchet: bool) -> int:
+        """Encog's best genome: the ratchet's best-ever, else the highest score (then key)."""
+        return self.best.key if ratchet and self.best is not None else max(fitness, key=lambda k: (fitness[k], k))
+
     def _start_population(self, ratchet: bool) -> dict[int, Any]:
         """The new population before any offspring: the ratchet's best genome, as it is (not
         evaluated again), or nothing."""
@@ -394,7 +412,7 @@ class NEATReproduction(neat.DefaultReproduction):
         """Encog's selection (see the class docstring) over the non-stagnant species."""
         ranked = {s.key: sorted(s.members, key=lambda k: (s.members[k].fitness, k), reverse=True) for s in remaining}
         fitness = {k: g.fitness for s in remaining for k, g in s.members.items()}
-        best_key = self.best.key if ratchet and self.best is not None else max(fitness, key=lambda k: (fitness[k], k))
+        best_key = self._best_key(fitness, ratchet)
         best_index = next((i for i, s in enumerate(remaining) if best_key in s.members), 0)
         counts = original_spawn([mean([m.fitness for m in s.members.values()]) for s in remaining],
                                 [s.members[ranked[s.key][0]].fitness for s in remaining], best_index, offspring)
