@@ -149,3 +149,13 @@ def test_rebuild_and_resume_do_not_mix(runs, tmp_path, capsys):
     shutil.copytree(whole, tmp_path / "run")
     assert evolve_main(["--resume", str(tmp_path / "run"), "--rebuild-from", str(record), "--no-progress"]) == 2
     assert "--rebuild-from" in capsys.readouterr().err
+
+
+def test_a_rebuild_into_the_record_itself_is_refused_and_changes_nothing(runs, tmp_path, capsys):
+    exp, _, record = runs
+    copy = tmp_path / "record"
+    shutil.copytree(record, copy)
+    before = {p.name: p.read_bytes() for p in copy.rglob("*") if p.is_file()}
+    line = _refused(exp, copy, copy, capsys)
+    assert "choose another --out" in line or "continue it with" in line
+    assert {p.name: p.read_bytes() for p in copy.rglob("*") if p.is_file()} == before
