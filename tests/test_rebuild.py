@@ -159,3 +159,22 @@ def test_a_rebuild_into_the_record_itself_is_refused_and_changes_nothing(runs, t
     line = _refused(exp, copy, copy, capsys)
     assert "choose another --out" in line or "continue it with" in line
     assert {p.name: p.read_bytes() for p in copy.rglob("*") if p.is_file()} == before
+
+
+COMMITTED = Path(__file__).parents[1] / "docs" / "evidence" / "original-S1-continued"
+
+
+def test_the_committed_record_rebuilds_with_this_code(tmp_path):
+    """The S1-original run continued across sessions (docs/evidence/original-S1-continued) is
+    rebuilt from its record: its first generations, bred, decoded and speciated by this code, ask
+    for the recorded genomes and give the recorded statistics. A change to breeding, speciation
+    or decoding that would alter that run fails here, before a session spends hours on it."""
+    keep = 5
+    copy = tmp_path / "record"
+    copy.mkdir()
+    shutil.copy(COMMITTED / "experiment.json", copy)
+    lines = (COMMITTED / "stats.jsonl").read_text().splitlines()[:keep]
+    (copy / "stats.jsonl").write_text("\n".join(lines) + "\n")
+    assert evolve_main(["--rebuild-from", str(copy), "--generations", str(keep), "--out", str(tmp_path / "r"),
+                        "--workers", "1", "--no-progress"]) == 0
+    assert comparable_stats(tmp_path / "r") == comparable_stats(copy)
