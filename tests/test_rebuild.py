@@ -121,7 +121,8 @@ def test_a_record_of_another_experiment_is_refused(runs, tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.parametrize("case", ["no scores", "bad score", "too many generations", "no experiment", "missing"])
+@pytest.mark.parametrize("case", ["no scores", "bad score", "too many generations", "no experiment", "missing",
+                                  "empty"])
 def test_bad_records_get_one_line_and_nothing_is_written(runs, tmp_path, case):
     exp, _, record = runs
     copy = tmp_path / "bad"
@@ -129,7 +130,9 @@ def test_bad_records_get_one_line_and_nothing_is_written(runs, tmp_path, case):
     records = read_stats(copy / "stats.jsonl")
     expect = {"no scores": "has no per-genome scores", "bad score": "allowed: a genome id with a list",
               "too many generations": "more than the new run's 2", "no experiment": "experiment.json: missing",
-              "missing": "no stats.jsonl there"}[case]
+              "missing": "no stats.jsonl there", "empty": "records no generation"}[case]
+    if case == "empty":
+        records = []
     if case == "no scores":
         del records[0]["trial_ft"]
     if case == "bad score":

@@ -85,6 +85,9 @@ def load_record(source: Path, experiment: dict[str, Any]) -> list[dict[str, Any]
         check_generations(stats_path, records)
     except ValueError as err:
         raise RebuildError(str(err)) from None
+    if not records:
+        raise RebuildError(f"{stats_path}: records no generation; allowed: the stats.jsonl of a run that finished "
+                           "at least one generation")
     for record in records:
         scores = record.get("trial_ft")
         if not isinstance(scores, dict):
