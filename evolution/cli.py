@@ -182,6 +182,9 @@ def evolve_main(argv: list[str] | None = None) -> int:
         return 0
     status = "converged" if result.converged else "finished"
     print(f"{status}: {result.generations} generations, best ft {result.best_task:.2f}")
+    if result.reused:
+        print(f"{result.reused} of {result.asked} genomes decoded to a team already scored on the same episodes "
+              "and took its scores (not simulated again)")
     print(f"run directory: {result.run_dir}  (stats.jsonl, stats.csv, stats.png, champion.json, checkpoints/)")
     return 0
 

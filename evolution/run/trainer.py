@@ -37,6 +37,7 @@ from evolution.run.experiment import Experiment
 from evolution.run.lock import RunLock
 from evolution.run.rebuild import RebuildingEvaluator, load_record
 from evolution.run.recorder import RunRecorder, convergence_target
+from evolution.run.reuse import ReusingEvaluator
 from evolution.run.rundir import check_new_run_dir, new_run, restore_run
 from gathering_env.compiled.engine import announce_compile
 
@@ -50,6 +51,10 @@ class RunResult:
     converged: bool
     interrupted: bool = False
     already_finished: bool = False
+    reused: int = 0
+    """Genomes of this invocation that took the evaluation of an identical team (``evolution.run.reuse``)."""
+    asked: int = 0
+    """Genomes this invocation had evaluated (the carried ones not counted)."""
 
 
 def protocol_notes(exp: Experiment) -> list[str]:
@@ -185,9 +190,10 @@ class Trainer:
                                                      self.max_retries)
         random.setstate(random_state)
         if recorded is not None:
-            evaluator = self._evaluator = RebuildingEvaluator(evaluator, recorded, context, self.rebuild_from)
+            evaluator = RebuildingEvaluator(evaluator, recorded, context, self.rebuild_from)
             print(f"{exp.name}: generations 0-{len(recorded) - 1} rebuilt from {self.rebuild_from} (its recorded "
                   "scores, each generation checked against its record), the rest simulated", flush=True)
+        evaluator = self._evaluator = ReusingEvaluator(evaluator, context)
         try:  # nothing is written before the backend is up and the run directory is locked
             lock.acquire()
             write()
@@ -210,7 +216,7 @@ class Trainer:
 
                 self._generation = generation
                 self._population = population
-                rebuilt = isinstance(evaluator, RebuildingEvaluator) and evaluator.rebuilds(generation)
+                rebuilt = recorded is not None and evaluator.rebuilds(generation)
                 amend = evaluator.check if rebuilt else None
                 population.run(self._fitness, 1)
                 self._check_run_dir(generation)
@@ -255,8 +261,10 @@ class Trainer:
         best = recorder.best[0] if recorder.best is not None else max((r["task_best"] for r in recorder.records),
                                                                         default=0.0)
         champion = recorder.champion_path
+        evaluator = getattr(self, "_evaluator", None)
         return RunResult(self.run_dir, len(recorder.records), best, champion if champion.exists() else None, converged,
-                         interrupted=interrupted, already_finished=already_finished)
+                         interrupted=interrupted, already_finished=already_finished,
+                         reused=getattr(evaluator, "reused", 0), asked=getattr(evaluator, "asked", 0))
 
     def _install_signal_handlers(self) -> dict[int, Any]:
         import signal
