@@ -35,7 +35,7 @@ def generation_record(generation: int, evaluations: Sequence[Evaluation], specie
     ``<obj>_best``, ``<obj>_mean``, ``<obj>_std``; ``num_sensors_mean``; per sensor type
     ``count_<type>_mean`` and, for configurable types, ``range_<type>_mean`` and
     ``fov_<type>_mean`` (over the genomes that have such a sensor; null if none);
-    ``steps`` simulated; and the timing keys ``seconds`` (wall clock of the generation),
+    ``steps`` simulated (a genome that took the evaluation of an identical team adds none: ``evolution.run.reuse``); and the timing keys ``seconds`` (wall clock of the generation),
     ``seconds_env``, ``seconds_controller``, ``seconds_decode`` (summed over genomes).
     """
     rec: dict[str, Any] = {"generation": int(generation), "genomes": len(evaluations),
