@@ -8,6 +8,7 @@ from small_runs import experiment_file
 
 from evolution.cli import evolve_main
 from evolution.run import reuse, trainer
+from evolution.run.experiment import load_experiment
 from evolution.run.stats import read_stats, without_timing
 
 CASES = {
@@ -17,38 +18,19 @@ CASES = {
 }
 
 
-class SimulateAll:
-    """The evaluator without reuse: every genome simulated."""
-
-    def __init__(self, inner, context):
-        self.inner, self.name, self.failures = inner, inner.name, inner.failures
-        self.reused = self.asked = 0
-
-    def map(self, genomes, generation):
-        return self.inner.map(genomes, generation)
-
-    def rebuilds(self, generation):
-        return getattr(self.inner, "rebuilds", lambda _: False)(generation)
-
-    def check(self, record):
-        return self.inner.check(record)
-
-    def close(self):
-        self.inner.close()
-
-
 def _run(exp, out, capsys):
     assert evolve_main([str(exp), "--out", str(out), "--workers", "1", "--no-progress", "--population", "16"]) == 0
     return capsys.readouterr().out
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
-def test_reuse_gives_the_run_of_simulating_every_genome(case, tmp_path, capsys, monkeypatch):
+def test_reuse_gives_the_run_of_simulating_every_genome(case, tmp_path, capsys):
     method, objectives, extra = CASES[case]
     exp = experiment_file(tmp_path, case, method, objectives, generations=4, extra=extra)
     said = _run(exp, tmp_path / "reuse", capsys)
-    monkeypatch.setattr(trainer, "ReusingEvaluator", SimulateAll)
-    _run(exp, tmp_path / "all", capsys)
+    every_run = trainer.Trainer(load_experiment(exp, {"population": 16}), tmp_path / "all", workers=1,
+                                progress=False, reuse=False).run()
+    assert every_run.reused == 0
     with_reuse, every = read_stats(tmp_path / "reuse" / "stats.jsonl"), read_stats(tmp_path / "all" / "stats.jsonl")
     drop = lambda rs: [{k: v for k, v in r.items() if k != "steps"} for r in without_timing(rs)]  # noqa: E731
     assert drop(with_reuse) == drop(every)

@@ -94,6 +94,9 @@ class Trainer:
             ``experiment`` is None (only ``generations`` and ``name`` may differ from the run).
         rebuild_from: a new run takes the scores of the generations recorded there (a run or
             evidence folder) instead of simulating them (``evolution.run.rebuild``).
+        reuse: a genome that decodes to a team already scored on the same episodes takes its
+            evaluation (``evolution.run.reuse``; the same statistics, fewer steps); False
+            simulates every genome (to measure what reuse saves).
 
     Output folder: the rules of ``evolution.run.rundir`` (a new run into a missing or empty
     folder; a resumed run verified before anything is written; one writer at a time, by the
@@ -108,13 +111,15 @@ class Trainer:
     def __init__(self, experiment: Experiment | None, run_dir: Path, workers: int | None = None,
                  resume: bool = False, resume_from: Path | None = None, progress: bool = True,
                  backend: str = "process", ray_address: str | None = None, max_retries: int = 2,
-                 overrides: dict[str, Any] | None = None, rebuild_from: Path | None = None) -> None:
+                 overrides: dict[str, Any] | None = None, rebuild_from: Path | None = None,
+                 reuse: bool = True) -> None:
         if experiment is None and not (resume or resume_from is not None):
             raise ValueError("experiment=None needs resume=True (the run's own experiment)")
         if rebuild_from is not None and (resume or resume_from is not None or experiment is None):
             raise UsageError(f"--rebuild-from {rebuild_from}: starts a new run from a record; allowed: an experiment "
                              "and a new --out, without --resume (a run with checkpoints resumes from them)")
         self.rebuild_from = Path(rebuild_from) if rebuild_from is not None else None
+        self.reuse = reuse
         self.experiment = experiment
         self.run_dir = Path(run_dir)
         self.workers = workers
@@ -193,7 +198,9 @@ class Trainer:
             evaluator = RebuildingEvaluator(evaluator, recorded, context, self.rebuild_from)
             print(f"{exp.name}: generations 0-{len(recorded) - 1} rebuilt from {self.rebuild_from} (its recorded "
                   "scores, each generation checked against its record), the rest simulated", flush=True)
-        evaluator = self._evaluator = ReusingEvaluator(evaluator, context)
+        if self.reuse:
+            evaluator = ReusingEvaluator(evaluator, context)
+        self._evaluator = evaluator
         try:  # nothing is written before the backend is up and the run directory is locked
             lock.acquire()
             write()
