@@ -21,7 +21,7 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
 from evolution.guard import ArgumentParser, command, int_arg  # noqa: E402
 from evolution.run.experiment import load_experiment, resolve_preset  # noqa: E402
-from evolution.run.stats import read_stats, without_timing  # noqa: E402
+from evolution.run.stats import read_stats, without_work  # noqa: E402
 from evolution.run.trainer import Trainer  # noqa: E402
 
 
@@ -47,8 +47,7 @@ def main(argv: list[str] | None = None) -> int:
         run(warm, Path(tmp) / "warm-up", reuse=False)  # compiled kernels and worker start-up, timed in neither
         every = run(args, Path(tmp) / "every", reuse=False)
         reused = run(args, Path(tmp) / "reuse", reuse=True)
-    same = ([{k: v for k, v in r.items() if k != "steps"} for r in without_timing(every)]
-            == [{k: v for k, v in r.items() if k != "steps"} for r in without_timing(reused)])
+    same = without_work(every) == without_work(reused)
     print(f"{args.preset}: {args.genomes} genomes x {args.steps} steps, {args.generations} generations, "
           f"{args.workers} workers")
     print(f"{'gen':>4} {'steps, every genome':>20} {'steps, reused':>14} {'s, every':>9} {'s, reused':>10}")

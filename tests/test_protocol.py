@@ -18,7 +18,7 @@ from evolution.run.evaluate import Evaluation, episode_seeds, trial_seed
 from evolution.run.experiment import ExperimentError, load_experiment, preset_text, resolve_preset
 from evolution.run.protocol import ORIGINAL, protocol_values
 from evolution.run.recorder import convergence_target
-from evolution.run.stats import read_stats, without_timing
+from evolution.run.stats import read_stats, without_work
 from gathering_env import Morphology, SensorSpec, morphological_complexity
 from gathering_env.compiled import kernels
 from gathering_env.config import WorldConfig
@@ -249,8 +249,8 @@ def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_pa
     evolve(exp, tmp_path / "part", "--resume")
     # steps aside: the resumed run simulates again the teams the whole run reused from the
     # generations before the resume (one layout: evolution.run.reuse keeps them in memory only)
-    whole = [{k: v for k, v in r.items() if k != "steps"} for r in without_timing(read_stats(tmp_path / "whole" / "stats.jsonl"))]
-    part = [{k: v for k, v in r.items() if k != "steps"} for r in without_timing(read_stats(tmp_path / "part" / "stats.jsonl"))]
+    whole = without_work(read_stats(tmp_path / "whole" / "stats.jsonl"))
+    part = without_work(read_stats(tmp_path / "part" / "stats.jsonl"))
     assert len(whole) == 4 and part == whole
     saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
     assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0

@@ -29,9 +29,9 @@ from typing import Any
 
 from evolution.guard import UsageError
 from evolution.run.evaluate import Evaluation, decode_genome, scored
-from evolution.run.stats import TIMING_KEYS, check_generations, read_stats
+from evolution.run.stats import WORK_KEYS, check_generations, read_stats
 
-RECORD_ONLY = (*TIMING_KEYS, "steps")
+RECORD_ONLY = WORK_KEYS
 """Statistics of a rebuilt generation taken from the record (they measure the recorded run's work)."""
 NOT_IDENTITY = ("name", "generations", "source")
 """Experiment keys a rebuilt run may change."""

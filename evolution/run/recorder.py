@@ -172,7 +172,7 @@ def trial_scores(evaluations: dict[int, Evaluation], carried: frozenset[int] = f
                  ) -> dict[str, list[float] | None]:
     """The record's ``trial_ft``: each genome scored this generation (id as a string) with its
     trials' ft, or None for a failed evaluation; ``carried`` genomes are left out. Everything
-    else about an evaluation follows from the genome (``evolution.run.replay``)."""
+    else about an evaluation follows from the genome (``evolution.run.rebuild``)."""
     return {str(key): None if ev.failed else [float(f) for f in ev.trial_ft]
             for key, ev in sorted(evaluations.items()) if key not in carried}
 

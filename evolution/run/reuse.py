@@ -53,7 +53,7 @@ class ReusingEvaluator:
         if any(k[1] != seeds for k in self._store):  # fresh layouts: last generation's teams never recur
             self._store = {k: v for k, v in self._store.items() if k[1] == seeds}
         keys = [(team_key(*decode_genome(ctx.method, g, ctx.neat_config, ctx.substrate)), seeds) for g in genomes]
-        if getattr(self.inner, "rebuilds", lambda _: False)(generation):
+        if self.rebuilds(generation):
             first = list(range(len(genomes)))  # a rebuilt generation: every genome answered from its record
         else:
             seen: set[Any] = set()

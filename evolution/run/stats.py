@@ -25,6 +25,9 @@ from gathering_env import SENSOR_TYPES
 
 OBJECTIVE_NAMES = ("task", "morphology", "controller")
 TIMING_KEYS = ("seconds", "seconds_env", "seconds_controller", "seconds_decode")
+WORK_KEYS = (*TIMING_KEYS, "steps")
+"""What measures a run's work rather than its result: equal runs may differ here (a resumed or
+rebuilt run, reuse of identical teams)."""
 
 
 def generation_record(generation: int, evaluations: Sequence[Evaluation], species: int,
@@ -35,7 +38,8 @@ def generation_record(generation: int, evaluations: Sequence[Evaluation], specie
     ``<obj>_best``, ``<obj>_mean``, ``<obj>_std``; ``num_sensors_mean``; per sensor type
     ``count_<type>_mean`` and, for configurable types, ``range_<type>_mean`` and
     ``fov_<type>_mean`` (over the genomes that have such a sensor; null if none);
-    ``steps`` simulated (a genome that took the evaluation of an identical team adds none: ``evolution.run.reuse``); and the timing keys ``seconds`` (wall clock of the generation),
+    ``steps`` simulated (a genome that took the evaluation of an identical team adds none:
+    ``evolution.run.reuse``); and the timing keys ``seconds`` (wall clock of the generation),
     ``seconds_env``, ``seconds_controller``, ``seconds_decode`` (summed over genomes).
     """
     rec: dict[str, Any] = {"generation": int(generation), "genomes": len(evaluations),
@@ -144,3 +148,8 @@ def write_csv(path: Path, records: Sequence[dict[str, Any]]) -> None:
 def without_timing(records: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     """Records with the wall-clock keys removed (for comparing runs)."""
     return [{k: v for k, v in r.items() if k not in TIMING_KEYS} for r in records]
+
+
+def without_work(records: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Records with the ``WORK_KEYS`` removed: the results of a run alone."""
+    return [{k: v for k, v in r.items() if k not in WORK_KEYS} for r in records]
