@@ -147,6 +147,14 @@ def test_bad_records_get_one_line_and_nothing_is_written(runs, tmp_path, case):
         load_record(copy, {**saved, "generations": 2 if case == "too many generations" else 5})
 
 
+def test_a_missing_record_without_an_experiment_is_one_line(tmp_path, capsys):
+    assert evolve_main(["--rebuild-from", str(tmp_path / "nope"), "--out", str(tmp_path / "out"),
+                        "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "nope: no stats.jsonl there" in err[0]
+    assert not (tmp_path / "out").exists()
+
+
 def test_rebuild_and_resume_do_not_mix(runs, tmp_path, capsys):
     exp, whole, record = runs
     shutil.copytree(whole, tmp_path / "run")

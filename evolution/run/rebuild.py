@@ -42,8 +42,12 @@ class RebuildError(UsageError):
 
 
 def _record_paths(source: Path) -> tuple[Path, Path]:
+    """(stats.jsonl, experiment.json) of a record; ``RebuildError`` if there is no stats.jsonl."""
     source = Path(source)
     stats = source / "stats.jsonl" if source.is_dir() else source
+    if not stats.is_file():
+        raise RebuildError(f"--rebuild-from {source}: no stats.jsonl there; allowed: a run or evidence folder "
+                           "(or its stats.jsonl) written by gathering-evolve")
     return stats, stats.parent / "experiment.json"
 
 
@@ -72,9 +76,6 @@ def load_record(source: Path, experiment: dict[str, Any]) -> list[dict[str, Any]
     to rebuild a run of ``experiment`` (``Experiment.to_dict()``) from; ``RebuildError`` naming
     the file if they cannot be."""
     stats_path, exp_path = _record_paths(source)
-    if not stats_path.is_file():
-        raise RebuildError(f"--rebuild-from {source}: no stats.jsonl there; allowed: a run or evidence folder "
-                           "(or its stats.jsonl) written by gathering-evolve")
     recorded = _read_experiment(exp_path)
     for key in sorted(set(recorded) | set(experiment)):
         if key not in NOT_IDENTITY and recorded.get(key) != experiment.get(key):
