@@ -36,6 +36,8 @@ REWARD_SCOPES: tuple[str, str] = ("team", "local")
 #: Where the pickup box sits (``WorldConfig.pickup_box``).
 PICKUP_BOXES: tuple[str, str] = ("front", "centre")
 GROUND_FRICTIONS: tuple[str, str] = ("threshold", "mass")
+#: How wheel commands move a robot (``WorldConfig.drive_model``, ``gathering_env.drive``).
+DRIVE_MODELS: tuple[str, str] = ("velocity", "force")
 GRAVITY = 9.81
 """Acceleration of gravity (units/s^2) that turns mass into ground friction ('mass')."""
 MASS_FRICTION = 0.1
@@ -87,6 +89,15 @@ class WorldConfig:
     """Maximum traction force a robot's wheels exert on the ground (force units)."""
     robot_drive_torque: float = 0.1
     """Maximum turning torque of a robot's wheels."""
+    drive_model: str = "velocity"
+    """How wheel commands move a robot (``gathering_env.drive``): 'velocity' (wheel speeds
+    ``command * robot_max_speed``, reached with at most ``robot_drive_force``; no side slip)
+    or 'force' (the original code's robot: wheel forces that fade with speed, an impulse that
+    removes 80 % of the forward velocity each step, and its own ground friction as its only
+    grip; the four fields above do not apply)."""
+    damping: float = 0.0
+    """Box2D-style damping of every robot and block: velocity and spin shrink by the factor
+    1 / (1 + damping * dt) each step (the original code: 0.1)."""
 
     # --- blocks (index 0/1/2 = small/medium/large) ------------------------------------
     block_counts: tuple[int, int, int] = ENVIRONMENT_PRESETS[2]
@@ -220,6 +231,7 @@ class WorldConfig:
         _check_float("drive_dead_band", self.drive_dead_band, 0.0, 1.0, high_open=True)
         for name in ("robot_restitution", "block_restitution", "wall_restitution"):
             _check_float(name, getattr(self, name), 0.0, 1.0)
+        _check_float("damping", self.damping, 0.0, 100.0)
         _check_float("block_friction_margin", self.block_friction_margin, 0.0, 1.0,
                      low_open=True, high_open=True)
         for i, count in enumerate(self.block_counts):
@@ -248,6 +260,12 @@ class WorldConfig:
         if self.ground_friction not in GROUND_FRICTIONS:
             raise ValueError(f"ground_friction={self.ground_friction!r}; allowed: "
                              f"{', '.join(map(repr, GROUND_FRICTIONS))}")
+        if self.drive_model not in DRIVE_MODELS:
+            raise ValueError(f"drive_model={self.drive_model!r}; allowed: "
+                             f"{', '.join(map(repr, DRIVE_MODELS))}")
+        if self.drive_model == "force" and self.drive_dead_band != 0.0:
+            raise ValueError(f"drive_dead_band={self.drive_dead_band!r} with drive_model='force': "
+                             "the force drive has its own dead band; allowed: 0")
         if self.ir_response not in ("linear", "gamma"):
             raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma'")
         if self.reward not in REWARDS:

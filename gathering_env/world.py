@@ -11,9 +11,12 @@ mixes it (``gathering_env.contacts``).
 
 Each robot is driven through a kinematic *control body* (pymunk's tank example): a pivot
 and a gear joint with ``max_bias = 0`` pull the robot's velocity towards the control
-body's velocity with at most ``robot_drive_force`` / ``robot_drive_torque``. The control
-velocity is the differential-drive velocity along the robot's heading, so the robot has
-no side-slip, brakes when its wheels stop, and can push with at most its drive force.
+body's velocity. By default (``drive_model = "velocity"``) the control velocity is the
+differential-drive velocity along the robot's heading and the joints exert at most
+``robot_drive_force`` / ``robot_drive_torque``, so the robot has no side-slip, brakes when
+its wheels stop, and can push with at most its drive force; ``"force"`` is the original
+code's robot (wheel forces, a traction impulse and the robot's own ground friction).
+Both are in ``gathering_env.drive``.
 
 State is exchanged with pymunk in bulk through ``pymunk.batch`` (one call to read every
 body's pose and velocity, one to set all velocities); the rest of the package works on the
@@ -32,9 +35,12 @@ import pymunk.batch as pbatch
 
 from .config import WorldConfig
 from .contacts import apply_restitution
+from .drive import control_limits, force_drive, substep_keep, velocity_drive
 from .placement import check_placement, lay_out
 
 _VEL = pbatch.BodyFields.VELOCITY | pbatch.BodyFields.ANGULAR_VELOCITY
+_VEL_FORCE = _VEL | pbatch.BodyFields.FORCE | pbatch.BodyFields.TORQUE
+"""What ``set_drive`` writes: velocities, and under the force drive also forces and torques."""
 _STATE = pbatch.BodyFields.POSITION | pbatch.BodyFields.ANGLE | _VEL
 """What ``fetch_raw`` reads: per body x, y, angle, vx, vy, angular velocity."""
 STATE_ARRAYS = ("robot_pos", "robot_angle", "block_pos", "block_angle", "robot_attached",
@@ -80,6 +86,8 @@ class GatheringWorld:
         cfg = self.config
         space = pymunk.Space()
         space.gravity = (0.0, 0.0)
+        # pymunk keeps damping ** h of every velocity a sub-step of h
+        space.damping = substep_keep(cfg) ** (cfg.physics_substeps / cfg.dt)
         space.iterations = cfg.physics_iterations
         # pymunk's default allowed overlap (0.1) is two thirds of a robot radius at our scale.
         space.collision_slop = 0.005
@@ -126,15 +134,16 @@ class GatheringWorld:
         apply_restitution(space, {"robot": robot_shapes, "block": block_shapes, "wall": walls}, cfg)
 
         self.control_bodies: list[pymunk.Body] = []
+        max_force, max_torque = control_limits(cfg)
         for body in self.robot_bodies:
             control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
             control.position = body.position
             pivot = pymunk.PivotJoint(control, body, (0, 0), (0, 0))
             pivot.max_bias = 0.0
-            pivot.max_force = cfg.robot_drive_force
+            pivot.max_force = max_force
             gear = pymunk.GearJoint(control, body, 0.0, 1.0)
             gear.max_bias = 0.0
-            gear.max_force = cfg.robot_drive_torque
+            gear.max_force = max_torque
             space.add(control, pivot, gear)
             self.control_bodies.append(control)
 
@@ -222,33 +231,37 @@ class GatheringWorld:
         self.block_pos[...] = blocks[:, :2]
         self.block_angle[...] = blocks[:, 2]
 
-    def set_velocities(self, vel: np.ndarray) -> None:
-        """Set every body's velocity from ``vel`` (rows, 3) in pymunk's body order. The array
-        is read in place (no copy) and stays registered: later calls with the same array
-        only repeat the pymunk call."""
-        if self._set_buf._float_buf is not vel:
-            self._set_buf.set_float_buf(vel)
-        pbatch.set_space_bodies(self.space, _VEL, self._set_buf)
+    @property
+    def drive_columns(self) -> int:
+        """Columns of the array ``set_drive`` takes: vx, vy, spin (3), then, under the force
+        drive, force x, force y and torque (6)."""
+        return 6 if self.config.drive_model == "force" else 3
+
+    def set_drive(self, drive: np.ndarray) -> None:
+        """Set every body's velocity (and, under the force drive, force and torque) from
+        ``drive`` (rows, ``drive_columns``) in pymunk's body order. The array is read in place
+        (no copy) and stays registered: later calls with the same array only repeat the pymunk
+        call."""
+        if self._set_buf._float_buf is not drive:
+            self._set_buf.set_float_buf(drive)
+        pbatch.set_space_bodies(self.space, _VEL_FORCE if drive.shape[1] == 6 else _VEL, self._set_buf)
 
     def apply_drive(self, wheels: np.ndarray) -> None:
-        """Set each robot's wheel drive for the next physics step.
+        """Set each robot's wheel drive for the next physics step (``gathering_env.drive``).
 
         Args:
-            wheels: (N, 2) left/right wheel commands in [-1, 1] (fraction of top speed).
+            wheels: (N, 2) left/right wheel commands in [-1, 1].
         """
         cfg = self.config
-        wheels = dead_band(wheels, cfg.drive_dead_band)
-        v_left = wheels[:, 0] * cfg.robot_max_speed
-        v_right = wheels[:, 1] * cfg.robot_max_speed
-        forward = 0.5 * (v_left + v_right)
-        spin = (v_right - v_left) / (2.0 * cfg.robot_radius)
-        vel = self.raw[:, 3:6].copy()   # every body's velocity as last read
-        rows = self._control_rows
-        heading = self.robot_angle + 0.5 * cfg.dt * spin  # mid-step heading: arcs, not polygons
-        vel[rows, 0] = forward * np.cos(heading)
-        vel[rows, 1] = forward * np.sin(heading)
-        vel[rows, 2] = spin
-        self.set_velocities(vel)
+        drive = np.zeros((self._num_rows, self.drive_columns))
+        drive[:, :3] = self.raw[:, 3:6]   # every body's velocity as last read
+        if cfg.drive_model == "force":
+            rows = self._robot_rows
+            drive[rows, 3:] = force_drive(wheels, self.robot_angle, drive[rows, :3], cfg)
+            drive[self._control_rows, :3] = 0.0   # at rest: their joints are the robots' ground friction
+        else:
+            drive[self._control_rows] = velocity_drive(wheels, self.robot_angle, cfg)
+        self.set_drive(drive)
 
     def step_physics(self) -> None:
         """Advance pymunk by ``dt`` (in ``physics_substeps`` equal sub-steps) and refresh the arrays.
@@ -364,10 +377,3 @@ class GatheringWorld:
             self.robot_attached[robot] = -1
         self.anchor_owner[block] = -1
         self.block_sticky_side[block] = -1
-
-
-def dead_band(wheels: np.ndarray, band: float) -> np.ndarray:
-    """Wheel commands after the drive's dead band: 0 up to ``band``, then linear to 1."""
-    if band == 0.0:
-        return wheels
-    return np.sign(wheels) * np.maximum(np.abs(wheels) - band, 0.0) / (1.0 - band)

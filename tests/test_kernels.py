@@ -182,10 +182,13 @@ def _episode(kernel: str, steps: int, morphology: Morphology, seed: int, **world
     dict(SMALL, pickup_box="centre", pickup_box_width=0.2, pickup_box_depth=0.1, zone_depth=4.0),
     dict(SMALL, ground_friction="mass", robot_restitution=1.0, block_restitution=0.4, wall_restitution=1.0,
          robot_drive_force=3.63, robot_max_speed=0.637, drive_dead_band=0.28),
+    dict(SMALL, ground_friction="mass", robot_restitution=1.0, block_restitution=0.4, wall_restitution=1.0,
+         drive_model="force", damping=0.1),
+    dict(SMALL, drive_model="force", physics_substeps=3, collision_avoidance=True),
 ], ids=["small", "avoidance", "weld-in-place", "gamma-substeps", "env3", "centre-box", "original-box",
-        "original-physics"])
+        "original-physics", "force-drive", "force-drive-substeps"])
 def test_whole_episodes_are_identical_on_both_kernels(world):
-    steps = 400
+    steps = 1000 if world.get("drive_model") == "force" else 400   # slower robots: reach the zone
     attached = gathered = shared = False
     for morphology in (Morphology.khepera_iii(), MIXED):
         ref, want = _episode("numpy", steps, morphology, 7, **world)
@@ -202,8 +205,11 @@ def test_whole_episodes_are_identical_on_both_kernels(world):
         # the comparison covered attachments and gathering (with releases), not only driving,
         # and in the plain small world blocks held by two robots on one sticky side (the
         # original's centre box of 0.1 x 0.2 lies inside the body and grips nothing here: its
-        # attachments are covered by the larger centre box)
-        assert attached and gathered and (shared or world != SMALL)
+        # attachments are covered by the larger centre box); under the force drive an attached
+        # robot's steering hardly turns it against its ground friction, so nothing is gathered
+        # in 1000 steps: its gathering is the same code, covered by the other worlds
+        force = world.get("drive_model") == "force"
+        assert attached and (gathered or force) and (shared or world != SMALL)
 
 
 def test_episode_that_terminates_early_is_identical():

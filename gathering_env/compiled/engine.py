@@ -110,7 +110,7 @@ class CompiledWorlds:
         self.block_sticky_side = np.full((w, b), -1, dtype=np.int64)
         self.anchor_owner = np.full((w, b, first.anchor_slots), -1, dtype=np.int64)
         self.raw = np.zeros((w,) + first.raw.shape)
-        self.vel = np.zeros((w, first.raw.shape[0], 3))
+        self.vel = np.zeros((w, first.raw.shape[0], first.drive_columns))
         self._vel_rows = list(self.vel)   # fixed views: pymunk keeps the buffer registered
         self.robot_rows = np.zeros((w, n), dtype=np.intp)
         self.block_rows = np.zeros((w, b), dtype=np.intp)
@@ -171,8 +171,8 @@ class CompiledWorlds:
         shaper = self.shaper
         if shaper.active:
             shaper.before(self.block_pos, self.robot_attached)
-        kernels.drive(wheels, self.robot_pos, self.robot_angle, self.robot_attached, self.control_rows,
-                      self.raw, self.params, self.flags, active, self.vel)
+        kernels.drive(wheels, self.robot_pos, self.robot_angle, self.robot_attached, self.robot_rows,
+                      self.control_rows, self.raw, self.params, self.flags, active, self.vel)
         substeps = self.config.physics_substeps
         h = self.config.dt / substeps
         vel = self._vel_rows
@@ -180,7 +180,7 @@ class CompiledWorlds:
         for w, world in enumerate(self.worlds):
             if not active[w]:
                 continue
-            world.set_velocities(vel[w])
+            world.set_drive(vel[w])
             space = world.space
             for _ in range(substeps):
                 space.step(h)

@@ -27,6 +27,18 @@ import math
 import numpy as np
 from numba import njit
 
+from ..drive import (
+    FADE_END,
+    FADE_START,
+    IMPULSE_CAP,
+    SPIN_TRACTION,
+    TRACTION,
+    WHEEL_FORCE,
+    WHEEL_OFFSET,
+    robot_moment,
+    spin_limit,
+    substep_keep,
+)
 from ..sensors import TYPE_CODES
 
 IR, US, COLOUR, CAMERA, BOTTOM = (TYPE_CODES[t] for t in ("infrared", "ultrasonic", "colour", "camera", "bottom"))
@@ -36,9 +48,9 @@ T_TYPE, T_BEARING, T_OFFSET, T_RANGE, T_COS_HALF, T_SIN_HALF, T_INV_RANGE = rang
 # Entries of the float parameter vector (see ``world_params``).
 (P_RADIUS, P_ARENA_W, P_ARENA_H, P_ZX0, P_ZY0, P_ZX1, P_ZY1, P_FALLOFF, P_IR_GAMMA, P_DT,
  P_MAX_SPEED, P_ZONE_CX, P_ZONE_CY, P_AVOID_DIST, P_BOX_W, P_BOX_D, P_REACH, P_TOTAL_VALUE,
- P_MAX_CYCLES, P_BOX_OFFSET, P_DEAD_BAND) = range(21)
+ P_MAX_CYCLES, P_BOX_OFFSET, P_DEAD_BAND, P_MASS, P_MOMENT, P_SUBSTEPS, P_KEEP, P_SPIN_LIMIT) = range(26)
 # Entries of the integer flag vector.
-F_IR_GAMMA, F_AVOIDANCE, F_PICKUP = range(3)
+F_IR_GAMMA, F_AVOIDANCE, F_PICKUP, F_FORCE_DRIVE = range(4)
 # Event kinds reported by ``settle`` (rows of the int event table: kind, world, robot, block, slot).
 EV_ATTACH, EV_RELEASE = 1, 2
 
@@ -68,10 +80,11 @@ def world_params(config) -> tuple[np.ndarray, np.ndarray]:
         config.bottom_falloff, config.ir_gamma, config.dt, config.robot_max_speed, cx, cy,
         config.collision_avoidance_distance, config.pickup_box_width, config.pickup_box_depth,
         config.pickup_reach, config.total_value, config.max_cycles, config.pickup_box_offset,
-        config.drive_dead_band,
+        config.drive_dead_band, config.robot_mass, robot_moment(config), config.physics_substeps, substep_keep(config),
+        spin_limit(config),
     ], dtype=np.float64)
-    flags = np.array([config.ir_response == "gamma", config.collision_avoidance, config.pickup_heuristic],
-                     dtype=np.int64)
+    flags = np.array([config.ir_response == "gamma", config.collision_avoidance, config.pickup_heuristic,
+                      config.drive_model == "force"], dtype=np.int64)
     return params, flags
 
 
@@ -82,6 +95,14 @@ def _dead_band(command, band):
         return command
     magnitude = max(abs(command) - band, 0.0) / (1.0 - band)
     return magnitude if command >= 0.0 else -magnitude
+
+
+@njit(cache=True)
+def _wheel_force(command, vx):
+    """'force' drive: the push of a wheel at ``command`` (``gathering_env.drive.wheel_force``)."""
+    along = abs(vx) if np.sign(vx) == np.sign(command) else 0.0
+    fade = min(max((FADE_END - along) / (FADE_END - FADE_START), 0.0), 1.0)
+    return command * WHEEL_FORCE * fade
 
 
 @njit(cache=True)
@@ -259,16 +280,20 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
 
 
 @njit(cache=True)
-def drive(wheels, robot_pos, robot_angle, robot_attached, control_rows, raw, params, flags, active, vel):
-    """Wheel commands -> control-body velocities for the next physics step.
+def drive(wheels, robot_pos, robot_angle, robot_attached, robot_rows, control_rows, raw, params, flags,
+          active, vel):
+    """Wheel commands -> control-body (and, in the 'force' drive, robot) velocities for the next
+    physics step (``gathering_env.drive``).
 
     Args:
         wheels: (W, N, 2) finite controller commands (clipped here to [-1, 1]).
         robot_pos (W, N, 2), robot_angle (W, N), robot_attached (W, N): current state.
-        control_rows: (W, N) row of each robot's control body in pymunk's body order.
+        robot_rows, control_rows: (W, N) row of each robot and of its control body in pymunk's
+            body order.
         raw: (W, rows, 6) bodies as last read (x, y, angle, vx, vy, angular velocity).
-        active: (W,) bool. vel: (W, rows, 3) written in place: every body's velocity, the
-            control bodies' replaced by the drive (what ``set_space_bodies`` reads).
+        active: (W,) bool. vel: (W, rows, 3 or 6) written in place: every body's velocity,
+            the control bodies' replaced by the drive, and under the force drive the robots'
+            forces and torques (what ``GatheringWorld.set_drive`` reads).
     """
     n_worlds, n = robot_angle.shape
     n_rows = raw.shape[1]
@@ -276,6 +301,13 @@ def drive(wheels, robot_pos, robot_angle, robot_attached, control_rows, raw, par
     max_speed = params[P_MAX_SPEED]
     band = params[P_DEAD_BAND]
     half_dt = 0.5 * params[P_DT]
+    dt = params[P_DT]
+    force_drive = flags[F_FORCE_DRIVE] != 0
+    mass, moment = params[P_MASS], params[P_MOMENT]
+    arm = WHEEL_OFFSET * r
+    spin_cap = params[P_SPIN_LIMIT]
+    h = dt / params[P_SUBSTEPS]
+    keep = params[P_KEEP]
     avoidance = flags[F_AVOIDANCE] != 0
     reach = r + params[P_AVOID_DIST]
     cx, cy = params[P_ZONE_CX], params[P_ZONE_CY]
@@ -331,6 +363,25 @@ def drive(wheels, robot_pos, robot_angle, robot_attached, control_rows, raw, par
             vel[w, row, 0] = raw[w, row, 3]
             vel[w, row, 1] = raw[w, row, 4]
             vel[w, row, 2] = raw[w, row, 5]
+        if force_drive:
+            for i in range(n):
+                row = robot_rows[w, i]
+                vx, vy, spin = raw[w, row, 3], raw[w, row, 4], raw[w, row, 5]
+                hx, hy = math.cos(robot_angle[w, i]), math.sin(robot_angle[w, i])
+                f_left = _wheel_force(left[i], vx)
+                f_right = _wheel_force(right[i], vx)
+                momentum = mass * (vx * hx + vy * hy)
+                removed = TRACTION * min(max(momentum, -IMPULSE_CAP), IMPULSE_CAP)
+                push = keep * (dt * (f_left + f_right) - removed) / h
+                new_spin = (1.0 - TRACTION * SPIN_TRACTION) * spin + dt * arm * (f_right - f_left) / moment
+                vel[w, row, 3] = push * hx
+                vel[w, row, 4] = push * hy
+                vel[w, row, 5] = keep * moment * (min(max(new_spin, -spin_cap), spin_cap) - spin) / h
+                row = control_rows[w, i]
+                vel[w, row, 0] = 0.0
+                vel[w, row, 1] = 0.0
+                vel[w, row, 2] = 0.0
+            continue
         for i in range(n):
             v_left = _dead_band(left[i], band) * max_speed
             v_right = _dead_band(right[i], band) * max_speed
