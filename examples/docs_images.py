@@ -132,6 +132,16 @@ def make_original_s1(args: argparse.Namespace) -> None:
                      title="S1-original")
 
 
+def make_original_s1_continued(args: argparse.Namespace) -> None:
+    """The curve of the S1-original run continued across sessions, from its committed record
+    (``docs/evidence/original-S1-continued/stats.jsonl``)."""
+    from evolution.run.plots import plot_run
+    from evolution.run.stats import read_stats
+
+    folder = DOCS / "evidence" / "original-S1-continued"
+    plot_run(read_stats(folder / "stats.jsonl"), folder / "stats.png", title="S1-original, continued")
+
+
 LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
 LEARNING_RUN_FILES = ("stats.png", "stats.jsonl", "stats.csv", "experiment.json", "champion.json")
 
@@ -165,6 +175,8 @@ STEPS: dict[str, Step] = {
     "rl": Step(tuple(f"rl/{f}" for f in (*RL_FIGURES, *RL_CURVES)), "rl", make_rl),
     "marl": Step(("rl/curves-marl-env1.png",), "marl", make_marl),
     "original-s1": Step(("evidence/original-S1/stats.png",), "original_s1", make_original_s1),
+    "original-s1-continued": Step(("evidence/original-S1-continued/stats.png",), None,
+                                  make_original_s1_continued),
     "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
                       "evidence/learning/M1/stats.png"), "learning", make_learning),
 }
