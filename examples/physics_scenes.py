@@ -4,9 +4,11 @@ Each scene drives robots with constant wheel commands and no grips (pickup off) 
 what the original's Java classes were measured doing in the same scene (its compiled 2018
 code, jbox2d, ``world.step(0.1, 6, 3)``; robots heading +y unless said; figures below as
 "fixed order / shuffled": every robot then the world, or MASON's shuffled schedule as the
-original runs, median of 20 seeds). Worlds compared: ``paper`` (this package's defaults)
-and ``original`` (the physics keys of ``protocol = "original"``: mass friction, Box2D
-restitution, the original robot's push and top speed).
+original runs, median of 20 seeds). Worlds compared: ``paper`` (this package's defaults),
+``original`` (the physics keys of ``protocol = "original"``: mass friction, Box2D
+restitution, the original robot's push and top speed) and ``force`` (the same with the
+original's robot as ``drive_model = "force"`` models it: wheel forces, traction impulse, its
+own ground friction, Box2D damping 0.1). Speeds are the mean over the last 20 steps.
 
     python examples/physics_scenes.py            # prints a markdown table (about 10 s)
 """
@@ -18,7 +20,7 @@ import math
 import numpy as np
 
 from evolution.guard import ArgumentParser, command
-from evolution.run.protocol import ORIGINAL_PHYSICS, protocol_values
+from evolution.run.protocol import ORIGINAL_FORCE_DRIVE, ORIGINAL_PHYSICS, protocol_values
 from gathering_env.config import WorldConfig
 from gathering_env.simulation import GatheringSimulation
 
@@ -44,9 +46,13 @@ ORIGINAL = {
 def physics(world: str) -> dict:
     """World overrides of a compared world (pickup off in both)."""
     keys = {}
-    if world == "original":
+    if world in ("original", "force"):
         env = protocol_values("original")["environment"]
         keys = {key: env[key] for key in ORIGINAL_PHYSICS}
+    if world == "force":
+        for key in ("robot_drive_force", "robot_max_speed", "drive_dead_band"):
+            del keys[key]
+        keys.update(ORIGINAL_FORCE_DRIVE)
     return keys
 
 
@@ -60,15 +66,17 @@ def simulation(world: str, block_type: int, robots: int) -> GatheringSimulation:
     return sim
 
 
-def free_drive(world: str, heading: float, steps: int = 300, drive: float = 1.0) -> float:
+def free_drive(world: str, heading: float, steps: int = 300, drive: float = 1.0, last: int = 20) -> float:
+    """Mean speed over the ``last`` of ``steps`` steps (the force drive heading +x stops and goes)."""
     sim = simulation(world, 0, 1)
     sim.world.place_block(0, 35.0, 35.0, 0.0)
     sim.world.place_robot(0, 2.0, 2.0, heading)
-    for _ in range(steps - 1):
+    for _ in range(steps - last):
         sim.step(np.full((1, 2), drive))
     before = sim.world.robot_pos[0].copy()
-    sim.step(np.full((1, 2), drive))
-    return float(np.hypot(*(sim.world.robot_pos[0] - before)) / sim.config.dt)
+    for _ in range(last):
+        sim.step(np.full((1, 2), drive))
+    return float(np.hypot(*(sim.world.robot_pos[0] - before)) / (last * sim.config.dt))
 
 
 def slide(world: str, speed: float = 0.5) -> float:
@@ -115,12 +123,13 @@ def measure(world: str) -> dict[str, float]:
 @command
 def main(argv: list[str] | None = None) -> int:
     ArgumentParser(description=__doc__.splitlines()[0]).parse_args(argv)
-    ours = {world: measure(world) for world in ("paper", "original")}
-    print("| scene | measured | original (fixed order / shuffled) | here, original protocol | here, paper |")
-    print("|---|---|---|---|---|")
+    ours = {world: measure(world) for world in ("paper", "original", "force")}
+    print("| scene | measured | original (fixed order / shuffled) | here, original protocol | here, paper "
+          "| here, force drive |")
+    print("|---|---|---|---|---|---|")
     for scene, (what, fixed, shuffled) in ORIGINAL.items():
         print(f"| {scene} | {what} | {fixed:.3g} / {shuffled:.3g} | {ours['original'][scene]:.3g} "
-              f"| {ours['paper'][scene]:.3g} |")
+              f"| {ours['paper'][scene]:.3g} | {ours['force'][scene]:.3g} |")
     return 0
 
 

@@ -67,6 +67,11 @@ ORIGINAL: dict[str, dict[str, Any]] = {
 ORIGINAL_PHYSICS = ("ground_friction", "robot_restitution", "block_restitution", "wall_restitution",
                     "robot_drive_force", "robot_max_speed", "drive_dead_band")
 
+#: The original's robot as ``drive_model = "force"`` models it (not part of the bundle yet: the
+#: S1-original evidence was run with the velocity drive's keys above). It replaces the
+#: velocity drive's three keys: ``robot_drive_force``, ``robot_max_speed``, ``drive_dead_band``.
+ORIGINAL_FORCE_DRIVE = {"drive_model": "force", "damping": 0.1}
+
 PROTOCOLS = ("paper", "original")
 
 #: One line per protocol, for ``gathering-evolve --list``.
@@ -130,4 +135,4 @@ def apply_protocol(name: str, sections: dict[str, dict[str, Any]], source: str,
             target[key] = list(value) if isinstance(value, list) else value
 
 
-__all__ = ["DESCRIPTIONS", "ORIGINAL", "ORIGINAL_PHYSICS", "PROTOCOLS", "apply_protocol", "protocol_values"]
+__all__ = ["DESCRIPTIONS", "ORIGINAL", "ORIGINAL_FORCE_DRIVE", "ORIGINAL_PHYSICS", "PROTOCOLS", "apply_protocol", "protocol_values"]
