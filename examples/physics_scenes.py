@@ -8,7 +8,9 @@ original runs, median of 20 seeds). Worlds compared: ``paper`` (this package's d
 ``original`` (the physics keys of ``protocol = "original"``: mass friction, Box2D
 restitution, the original robot's push and top speed) and ``force`` (the same with the
 original's robot as ``drive_model = "force"`` models it: wheel forces, traction impulse, its
-own ground friction, Box2D damping 0.1). Speeds are the mean over the last 20 steps.
+own ground friction, Box2D damping 0.1) and ``shuffled`` (the force drive under MASON's shuffled
+schedule, ``schedule = "shuffled"``: the median over the schedules of seeds 0..19, as the
+original's shuffled figures are). Speeds are the mean over the last 20 steps.
 
     python examples/physics_scenes.py            # prints a markdown table (about 10 s)
 """
@@ -43,32 +45,39 @@ ORIGINAL = {
 }
 
 
+SHUFFLED_SEEDS = range(20)
+"""The schedules the 'shuffled' world's figures are the median over (the original's: 20 seeds)."""
+
+
 def physics(world: str) -> dict:
-    """World overrides of a compared world (pickup off in both)."""
+    """World overrides of a compared world (pickup off in all)."""
     keys = {}
-    if world in ("original", "force"):
+    if world in ("original", "force", "shuffled"):
         env = protocol_values("original")["environment"]
         keys = {key: env[key] for key in ORIGINAL_PHYSICS}
-    if world == "force":
+    if world in ("force", "shuffled"):
         for key in ("robot_drive_force", "robot_max_speed", "drive_dead_band"):
             del keys[key]
         keys.update(ORIGINAL_FORCE_DRIVE)
+    if world == "shuffled":
+        keys["schedule"] = "shuffled"
     return keys
 
 
-def simulation(world: str, block_type: int, robots: int) -> GatheringSimulation:
+def simulation(world: str, block_type: int, robots: int, seed: int = 0) -> GatheringSimulation:
     counts = [0, 0, 0]
     counts[block_type] = 1
     cfg = WorldConfig.from_kwargs(environment=None, block_counts=counts, num_robots=robots,
                                   pickup_heuristic=False, max_cycles=100_000, **physics(world))
     sim = GatheringSimulation(cfg)
-    sim.reset(seed=0)
+    sim.reset(seed=seed)   # every body is placed by hand: the seed only picks the schedule
     return sim
 
 
-def free_drive(world: str, heading: float, steps: int = 300, drive: float = 1.0, last: int = 20) -> float:
+def free_drive(world: str, heading: float, steps: int = 300, drive: float = 1.0, last: int = 20,
+               seed: int = 0) -> float:
     """Mean speed over the ``last`` of ``steps`` steps (the force drive heading +x stops and goes)."""
-    sim = simulation(world, 0, 1)
+    sim = simulation(world, 0, 1, seed)
     sim.world.place_block(0, 35.0, 35.0, 0.0)
     sim.world.place_robot(0, 2.0, 2.0, heading)
     for _ in range(steps - last):
@@ -79,8 +88,8 @@ def free_drive(world: str, heading: float, steps: int = 300, drive: float = 1.0,
     return float(np.hypot(*(sim.world.robot_pos[0] - before)) / (last * sim.config.dt))
 
 
-def slide(world: str, speed: float = 0.5) -> float:
-    sim = simulation(world, 0, 1)
+def slide(world: str, speed: float = 0.5, seed: int = 0) -> float:
+    sim = simulation(world, 0, 1, seed)
     w = sim.world
     w.place_robot(0, 35.0, 35.0, 0.0)
     w.place_block(0, *START, 0.0)
@@ -91,9 +100,9 @@ def slide(world: str, speed: float = 0.5) -> float:
     return float(np.hypot(*(w.block_pos[0] - START)))
 
 
-def push(world: str, block_type: int, robots: int, steps: int = 500) -> float:
+def push(world: str, block_type: int, robots: int, steps: int = 500, seed: int = 0) -> float:
     """``robots`` side by side (0.32 apart) 0.01 below the block's south face, heading north."""
-    sim = simulation(world, block_type, robots)
+    sim = simulation(world, block_type, robots, seed)
     w, cfg = sim.world, sim.config
     w.place_block(0, *START, 0.0)
     for i in range(robots):
@@ -105,31 +114,39 @@ def push(world: str, block_type: int, robots: int, steps: int = 500) -> float:
 
 
 def measure(world: str) -> dict[str, float]:
+    """Every scene's figure in ``world`` (under 'shuffled' the median over ``SHUFFLED_SEEDS``)."""
+    if world == "shuffled":
+        runs = [measure_once(world, seed) for seed in SHUFFLED_SEEDS]
+        return {scene: float(np.median([run[scene] for run in runs])) for scene in runs[0]}
+    return measure_once(world, 0)
+
+
+def measure_once(world: str, seed: int) -> dict[str, float]:
     return {
-        "free robot, full drive, heading +y": free_drive(world, math.pi / 2),
-        "free robot, full drive, heading +x": free_drive(world, 0.0),
-        "free robot, drive 0.5, heading +y": free_drive(world, math.pi / 2, drive=0.5),
-        "free robot, drive 0.3, heading +y": free_drive(world, math.pi / 2, drive=0.3),
-        "block sliding from 0.5 units/s": slide(world),
-        "1 robot, small block": push(world, 0, 1),
-        "1 robot, medium block": push(world, 1, 1),
-        "1 robot, large block": push(world, 2, 1),
-        "2 robots, medium block": push(world, 1, 2),
-        "2 robots, large block": push(world, 2, 2),
-        "3 robots, large block": push(world, 2, 3),
+        "free robot, full drive, heading +y": free_drive(world, math.pi / 2, seed=seed),
+        "free robot, full drive, heading +x": free_drive(world, 0.0, seed=seed),
+        "free robot, drive 0.5, heading +y": free_drive(world, math.pi / 2, drive=0.5, seed=seed),
+        "free robot, drive 0.3, heading +y": free_drive(world, math.pi / 2, drive=0.3, seed=seed),
+        "block sliding from 0.5 units/s": slide(world, seed=seed),
+        "1 robot, small block": push(world, 0, 1, seed=seed),
+        "1 robot, medium block": push(world, 1, 1, seed=seed),
+        "1 robot, large block": push(world, 2, 1, seed=seed),
+        "2 robots, medium block": push(world, 1, 2, seed=seed),
+        "2 robots, large block": push(world, 2, 2, seed=seed),
+        "3 robots, large block": push(world, 2, 3, seed=seed),
     }
 
 
 @command
 def main(argv: list[str] | None = None) -> int:
     ArgumentParser(description=__doc__.splitlines()[0]).parse_args(argv)
-    ours = {world: measure(world) for world in ("paper", "original", "force")}
+    ours = {world: measure(world) for world in ("paper", "original", "force", "shuffled")}
     print("| scene | measured | original (fixed order / shuffled) | here, original protocol | here, paper "
-          "| here, force drive |")
-    print("|---|---|---|---|---|---|")
+          "| here, force drive | here, force drive, shuffled |")
+    print("|---|---|---|---|---|---|---|")
     for scene, (what, fixed, shuffled) in ORIGINAL.items():
         print(f"| {scene} | {what} | {fixed:.3g} / {shuffled:.3g} | {ours['original'][scene]:.3g} "
-              f"| {ours['paper'][scene]:.3g} | {ours['force'][scene]:.3g} |")
+              f"| {ours['paper'][scene]:.3g} | {ours['force'][scene]:.3g} | {ours['shuffled'][scene]:.3g} |")
     return 0
 
 

@@ -38,6 +38,8 @@ PICKUP_BOXES: tuple[str, str] = ("front", "centre")
 GROUND_FRICTIONS: tuple[str, str] = ("threshold", "mass")
 #: How wheel commands move a robot (``WorldConfig.drive_model``, ``gathering_env.drive``).
 DRIVE_MODELS: tuple[str, str] = ("velocity", "force")
+#: When robots act relative to the physics step (``WorldConfig.schedule``, ``gathering_env.drive``).
+SCHEDULES: tuple[str, str] = ("fixed", "shuffled")
 GRAVITY = 9.81
 """Acceleration of gravity (units/s^2) that turns mass into ground friction ('mass')."""
 MASS_FRICTION = 0.1
@@ -98,6 +100,12 @@ class WorldConfig:
     damping: float = 0.0
     """Box2D-style damping of every robot and block: velocity and spin shrink by the factor
     1 / (1 + damping * dt) each step (the original code: 0.1)."""
+    schedule: str = "fixed"
+    """When each robot's drive acts, relative to the physics step: 'fixed' (every robot, then
+    the physics step) or 'shuffled' (the original code's MASON schedule, which shuffles the
+    robots and the physics step every step, so a robot's drive reaches a physics step 0, 1 or
+    2 times; drawn from the episode's seed; ``drive_model = 'force'`` only;
+    ``gathering_env.drive.shuffled_times``)."""
 
     # --- blocks (index 0/1/2 = small/medium/large) ------------------------------------
     block_counts: tuple[int, int, int] = ENVIRONMENT_PRESETS[2]
@@ -266,6 +274,11 @@ class WorldConfig:
         if self.drive_model == "force" and self.drive_dead_band != 0.0:
             raise ValueError(f"drive_dead_band={self.drive_dead_band!r} with drive_model='force': "
                              "the force drive has its own dead band; allowed: 0")
+        if self.schedule not in SCHEDULES:
+            raise ValueError(f"schedule={self.schedule!r}; allowed: {', '.join(map(repr, SCHEDULES))}")
+        if self.schedule == "shuffled" and self.drive_model != "force":
+            raise ValueError(f"schedule='shuffled' with drive_model={self.drive_model!r}: the shuffled "
+                             "schedule acts on wheel forces; allowed: drive_model='force', or schedule='fixed'")
         if self.ir_response not in ("linear", "gamma"):
             raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma'")
         if self.reward not in REWARDS:

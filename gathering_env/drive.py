@@ -36,6 +36,18 @@ velocity and spin towards the control body's with at most their ``max_force`` /
     does; so positions move with the solved velocities (setting the velocities instead would
     move each robot a step with its unsolved velocity, ignoring its friction).
 
+``schedule = 'shuffled'`` (the original's MASON schedule, force drive only)
+    MASON steps the robots and the physics world as agents of one ordering and shuffles
+    them every step. A robot that acts before the physics step drives it; one that acts
+    after drives the next one. So each physics step receives a robot's drive ``times`` =
+    0, 1 or 2 times (``shuffled_times``): once for acting before it in this step, once for
+    having acted after the previous one. Both actions sense the same positions (nothing
+    moves between them), so the same command is applied twice in a row, the second time on
+    the velocity the first impulse left (``force_drive``'s ``times``). Measured on the
+    original's own classes, this makes a free robot faster (0.84 against 0.64 units/s) and
+    a lone pusher push further; ``examples/physics_scenes.py`` has the figures. Under
+    'fixed' every robot acts once, before the physics step.
+
 The numpy functions here are the reference; ``gathering_env.compiled.kernels.drive`` does
 the same for a batch of worlds.
 """
@@ -124,10 +136,29 @@ def wheel_force(command: np.ndarray, vx: np.ndarray) -> np.ndarray:
     return command * WHEEL_FORCE * fade
 
 
+def shuffled_times(rng: np.random.Generator, acted_after: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """'shuffled' schedule: how often each robot's drive reaches this physics step.
+
+    Args:
+        rng: the episode's schedule generator (one uniform draw per robot and one for the
+            physics step, every step: their order in MASON's shuffle).
+        acted_after: (N,) bool, the robots that acted after the previous physics step.
+
+    Returns:
+        ``(times, acted_after)``: (N,) int64 in {0, 1, 2}, and the robots that act after this
+        physics step (they drive the next one)."""
+    keys = rng.random(acted_after.shape[0] + 1)
+    before = keys[:-1] < keys[-1]
+    return before.astype(np.int64) + acted_after, ~before
+
+
 def force_drive(wheels: np.ndarray, angle: np.ndarray, vel: np.ndarray,
-                config: WorldConfig) -> np.ndarray:
+                config: WorldConfig, times: np.ndarray | None = None) -> np.ndarray:
     """'force': (N, 3) force (x, y) and torque on each robot for the next physics step, from
     (N, 2) wheel commands and the velocities ``vel`` (N, 3: vx, vy, spin) the robots have now.
+
+    ``times`` (N,) in {0, 1, 2} (default: 1 each): how often each robot's drive acts before
+    the step (``shuffled_times``); a second action reads the velocity the first impulse left.
 
     Forces and impulses enter as the force that changes the velocity as much in one sub-step
     (pymunk clears forces after each), damped as Box2D damps them (``substep_keep``), so a
@@ -136,14 +167,24 @@ def force_drive(wheels: np.ndarray, angle: np.ndarray, vel: np.ndarray,
     dt, h = config.dt, config.dt / config.physics_substeps
     vx, vy, spin = vel[:, 0], vel[:, 1], vel[:, 2]
     hx, hy = np.cos(angle), np.sin(angle)
-    f_left = wheel_force(wheels[:, 0], vx)
-    f_right = wheel_force(wheels[:, 1], vx)
-    momentum = m * (vx * hx + vy * hy)
-    removed = TRACTION * np.clip(momentum, -IMPULSE_CAP, IMPULSE_CAP)
+    wheel_sum = np.zeros_like(vx)       # f_left + f_right over the actions
+    wheel_diff = np.zeros_like(vx)      # f_right - f_left over the actions
+    removed = np.zeros_like(vx)         # forward momentum the impulses removed
+    for action in range(1 if times is None else int(times.max(initial=0))):
+        acts = True if times is None else times > action
+        f_left = wheel_force(wheels[:, 0], vx)
+        f_right = wheel_force(wheels[:, 1], vx)
+        taken = TRACTION * np.clip(m * (vx * hx + vy * hy), -IMPULSE_CAP, IMPULSE_CAP)
+        wheel_sum = np.where(acts, wheel_sum + (f_left + f_right), wheel_sum)
+        wheel_diff = np.where(acts, wheel_diff + (f_right - f_left), wheel_diff)
+        removed = np.where(acts, removed + taken, removed)
+        vx = np.where(acts, vx - taken / m * hx, vx)
+        vy = np.where(acts, vy - taken / m * hy, vy)
+        spin = np.where(acts, (1.0 - TRACTION * SPIN_TRACTION) * spin, spin)
     keep = substep_keep(config)
-    push = keep * (dt * (f_left + f_right) - removed) / h
+    push = keep * (dt * wheel_sum - removed) / h
     arm = WHEEL_OFFSET * config.robot_radius
-    new_spin = (1.0 - TRACTION * SPIN_TRACTION) * spin + dt * arm * (f_right - f_left) / moment
+    new_spin = spin + dt * arm * wheel_diff / moment
     cap = spin_limit(config)
-    torque = keep * moment * (np.clip(new_spin, -cap, cap) - spin) / h
+    torque = keep * moment * (np.clip(new_spin, -cap, cap) - vel[:, 2]) / h
     return np.stack([push * hx, push * hy, torque], axis=1)

@@ -35,7 +35,7 @@ import pymunk.batch as pbatch
 
 from .config import WorldConfig
 from .contacts import apply_restitution
-from .drive import control_limits, force_drive, substep_keep, velocity_drive
+from .drive import control_limits, force_drive, shuffled_times, substep_keep, velocity_drive
 from .placement import check_placement, lay_out
 
 _VEL = pbatch.BodyFields.VELOCITY | pbatch.BodyFields.ANGULAR_VELOCITY
@@ -158,6 +158,9 @@ class GatheringWorld:
         self.block_sticky_side = np.full(b, -1, dtype=np.int64)
         self.anchor_owner = np.full((b, self.anchor_slots), -1, dtype=np.int64)
         self._welds: dict[int, tuple[pymunk.Constraint, pymunk.Constraint]] = {}
+        # The shuffled schedule's own generator, drawn after the layout (which it leaves alone).
+        self._schedule_rng = np.random.default_rng(rng.integers(2 ** 63)) if cfg.schedule == "shuffled" else None
+        self._acted_after = np.zeros(n, dtype=bool)
         self.read_state()
 
     @property
@@ -246,6 +249,15 @@ class GatheringWorld:
             self._set_buf.set_float_buf(drive)
         pbatch.set_space_bodies(self.space, _VEL_FORCE if drive.shape[1] == 6 else _VEL, self._set_buf)
 
+    def schedule_times(self) -> np.ndarray | None:
+        """How often each robot's drive reaches the next physics step under ``schedule =
+        'shuffled'`` ((N,) in {0, 1, 2}; ``gathering_env.drive.shuffled_times``), advancing the
+        schedule by one step; None under 'fixed' (once each)."""
+        if self._schedule_rng is None:
+            return None
+        times, self._acted_after = shuffled_times(self._schedule_rng, self._acted_after)
+        return times
+
     def apply_drive(self, wheels: np.ndarray) -> None:
         """Set each robot's wheel drive for the next physics step (``gathering_env.drive``).
 
@@ -257,7 +269,7 @@ class GatheringWorld:
         drive[:, :3] = self.raw[:, 3:6]   # every body's velocity as last read
         if cfg.drive_model == "force":
             rows = self._robot_rows
-            drive[rows, 3:] = force_drive(wheels, self.robot_angle, drive[rows, :3], cfg)
+            drive[rows, 3:] = force_drive(wheels, self.robot_angle, drive[rows, :3], cfg, self.schedule_times())
             drive[self._control_rows, :3] = 0.0   # at rest: their joints are the robots' ground friction
         else:
             drive[self._control_rows] = velocity_drive(wheels, self.robot_angle, cfg)

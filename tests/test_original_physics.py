@@ -159,7 +159,7 @@ def test_the_fidelity_pages_pushing_table_is_what_the_scenes_measure_today():
     scenes = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(scenes)
     page = (root / "docs" / "fidelity.md").read_text()
-    for world, column in (("original", 3), ("paper", 4), ("force", 5)):
+    for world, column in (("original", 3), ("paper", 4), ("force", 5), ("shuffled", 6)):
         for scene, value in scenes.measure(world).items():
             row = next(line for line in page.splitlines() if line.startswith(f"| {scene} |"))
             assert row.split("|")[1 + column].strip() == f"{value:.3g}", (world, scene)

@@ -111,6 +111,8 @@ class CompiledWorlds:
         self.anchor_owner = np.full((w, b, first.anchor_slots), -1, dtype=np.int64)
         self.raw = np.zeros((w,) + first.raw.shape)
         self.vel = np.zeros((w, first.raw.shape[0], first.drive_columns))
+        self._shuffled = cfg.schedule == "shuffled"
+        self.times = np.ones((w, n), dtype=np.int64)   # force-drive actions a step (drive.shuffled_times)
         self._vel_rows = list(self.vel)   # fixed views: pymunk keeps the buffer registered
         self.robot_rows = np.zeros((w, n), dtype=np.intp)
         self.block_rows = np.zeros((w, b), dtype=np.intp)
@@ -171,8 +173,12 @@ class CompiledWorlds:
         shaper = self.shaper
         if shaper.active:
             shaper.before(self.block_pos, self.robot_attached)
+        if self._shuffled:
+            for w, world in enumerate(self.worlds):
+                if active[w]:
+                    self.times[w] = world.schedule_times()
         kernels.drive(wheels, self.robot_pos, self.robot_angle, self.robot_attached, self.robot_rows,
-                      self.control_rows, self.raw, self.params, self.flags, active, self.vel)
+                      self.control_rows, self.raw, self.params, self.flags, active, self.times, self.vel)
         substeps = self.config.physics_substeps
         h = self.config.dt / substeps
         vel = self._vel_rows

@@ -281,7 +281,7 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
 
 @njit(cache=True)
 def drive(wheels, robot_pos, robot_angle, robot_attached, robot_rows, control_rows, raw, params, flags,
-          active, vel):
+          active, times, vel):
     """Wheel commands -> control-body (and, in the 'force' drive, robot) velocities for the next
     physics step (``gathering_env.drive``).
 
@@ -291,7 +291,8 @@ def drive(wheels, robot_pos, robot_angle, robot_attached, robot_rows, control_ro
         robot_rows, control_rows: (W, N) row of each robot and of its control body in pymunk's
             body order.
         raw: (W, rows, 6) bodies as last read (x, y, angle, vx, vy, angular velocity).
-        active: (W,) bool. vel: (W, rows, 3 or 6) written in place: every body's velocity,
+        active: (W,) bool. times: (W, N) int, how often each robot's force drive acts before
+            this step (1 under the fixed schedule; ``gathering_env.drive.shuffled_times``). vel: (W, rows, 3 or 6) written in place: every body's velocity,
             the control bodies' replaced by the drive, and under the force drive the robots'
             forces and torques (what ``GatheringWorld.set_drive`` reads).
     """
@@ -368,15 +369,24 @@ def drive(wheels, robot_pos, robot_angle, robot_attached, robot_rows, control_ro
                 row = robot_rows[w, i]
                 vx, vy, spin = raw[w, row, 3], raw[w, row, 4], raw[w, row, 5]
                 hx, hy = math.cos(robot_angle[w, i]), math.sin(robot_angle[w, i])
-                f_left = _wheel_force(left[i], vx)
-                f_right = _wheel_force(right[i], vx)
-                momentum = mass * (vx * hx + vy * hy)
-                removed = TRACTION * min(max(momentum, -IMPULSE_CAP), IMPULSE_CAP)
-                push = keep * (dt * (f_left + f_right) - removed) / h
-                new_spin = (1.0 - TRACTION * SPIN_TRACTION) * spin + dt * arm * (f_right - f_left) / moment
+                wheel_sum = 0.0
+                wheel_diff = 0.0
+                removed = 0.0
+                for _ in range(times[w, i]):
+                    f_left = _wheel_force(left[i], vx)
+                    f_right = _wheel_force(right[i], vx)
+                    taken = TRACTION * min(max(mass * (vx * hx + vy * hy), -IMPULSE_CAP), IMPULSE_CAP)
+                    wheel_sum = wheel_sum + (f_left + f_right)
+                    wheel_diff = wheel_diff + (f_right - f_left)
+                    removed = removed + taken
+                    vx = vx - taken / mass * hx
+                    vy = vy - taken / mass * hy
+                    spin = (1.0 - TRACTION * SPIN_TRACTION) * spin
+                push = keep * (dt * wheel_sum - removed) / h
+                new_spin = spin + dt * arm * wheel_diff / moment
                 vel[w, row, 3] = push * hx
                 vel[w, row, 4] = push * hy
-                vel[w, row, 5] = keep * moment * (min(max(new_spin, -spin_cap), spin_cap) - spin) / h
+                vel[w, row, 5] = keep * moment * (min(max(new_spin, -spin_cap), spin_cap) - raw[w, row, 5]) / h
                 row = control_rows[w, i]
                 vel[w, row, 0] = 0.0
                 vel[w, row, 1] = 0.0
