@@ -7,8 +7,11 @@ ft, blocks gathered by type, time to finish) and ``compare.png`` (a bar plot).
 
 ``--protocol original`` runs them in the original protocol's world (``evolution.run.protocol``:
 zone 20 x 4, the pickup box at the robot's centre, the Khepera-like IR curve), where a champion of
-an ``S1-original`` run was evolved; the default is the paper's world. A champion evolved in
-another world than the one compared in is named in a note on standard output.
+an ``S1-original`` run was evolved; the default is the paper's world. ``--world-from
+CHAMPION.json`` runs them in the world a champion was evolved in (its ``environment`` keys, such
+as ``drive_model`` or ``schedule``; also its preset, steps and team size unless
+``--environment``, ``--steps`` or ``--robots`` is given). A champion evolved in another world than the one
+compared in is named in a note on standard output.
 
 Policies: ``evolution.policies`` (the names ``--policy`` takes are listed there).
 """
@@ -23,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from evolution.guard import ArgumentParser, check_output_dir, command, int_arg, writing
+from evolution.guard import ArgumentParser, UsageError, check_output_dir, command, int_arg, writing
 from evolution.policies import POLICY_NAMES, Policy, make_policy
 from evolution.run.experiment import LIMITS
 from evolution.run.lock import LOCK_FILE, RunLock
@@ -140,26 +143,41 @@ def compare_main(argv: list[str] | None = None) -> int:
                             formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--policy", action="append", required=True,
                         help=f"{POLICY_NAMES.replace(', ', ' | ')} (repeat)")
-    parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3),
-                        help="environment preset (paper Table 2; default 2)")
-    parser.add_argument("--steps", type=int_arg(1, 10**9), default=10_000, help="max_cycles per episode")
-    parser.add_argument("--robots", type=int_arg(1, 1000), default=20, help="team size (default 20)")
+    parser.add_argument("--environment", type=int, choices=(1, 2, 3),
+                        help="environment preset (paper Table 2; default 2, or --world-from's)")
+    parser.add_argument("--steps", type=int_arg(1, 10**9),
+                        help="max_cycles per episode (default 10000, or --world-from's)")
+    parser.add_argument("--robots", type=int_arg(1, 1000), help="team size (default 20, or --world-from's)")
     parser.add_argument("--episodes", type=int_arg(1, 10_000), default=5, help="episodes (seeds 0..n-1) per policy")
     parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0, help="first episode seed")
-    parser.add_argument("--protocol", choices=PROTOCOLS, default="paper",
+    parser.add_argument("--protocol", choices=PROTOCOLS, default=None,
                         help="whose world: paper (default) or original (zone 20 x 4, centre pickup box, "
                              "Khepera-like IR; evolution.run.protocol)")
+    parser.add_argument("--world-from", type=Path, metavar="CHAMPION",
+                        help="the world a champion.json was evolved in (its environment keys; its preset, "
+                             "steps and team size unless given); not with --protocol")
     parser.add_argument("--out", type=Path, default=Path("compare"),
                         help="folder for compare.md, compare.csv, compare.png (default compare/)")
     args = parser.parse_args(argv)
+    if args.world_from is not None and args.protocol is not None:
+        raise UsageError("--world-from and --protocol both name the world; allowed: one of them")
     check_output_dir(args.out, (*COMPARE_FILES, LOCK_FILE))
-    env_config = {"environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots,
-                  **protocol_values(args.protocol)["environment"]}
+    if args.world_from is not None:
+        world = make_policy(f"champion:{args.world_from}").environment or {}
+        where = f", the world of {args.world_from}"
+    else:
+        world = protocol_values(args.protocol or "paper")["environment"]
+        where = ", original protocol" if args.protocol == "original" else ""
+    for name, key, default in (("environment", "environment", 2), ("steps", "max_cycles", 10_000),
+                               ("robots", "num_robots", 20)):
+        if getattr(args, name) is None:
+            setattr(args, name, world.get(key, default))
+    env_config = {**world, "environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots}
     WorldConfig.from_kwargs(**env_config)
     policies = [make_policy(p) for p in args.policy]
     for line in world_notes(policies, env_config):
         print(line)
-    title = (f"environment {args.environment}{', original protocol' if args.protocol == 'original' else ''}, "
+    title = (f"environment {args.environment}{where}, "
              f"{args.robots} robots, {args.steps} steps, "
              f"{args.episodes} episodes (seeds {args.seed}..{args.seed + args.episodes - 1})")
     # one writer per --out: a second copy stops here, before any episode

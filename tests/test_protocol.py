@@ -499,6 +499,40 @@ def test_compare_runs_in_the_protocols_world(tmp_path, monkeypatch, capsys):
     assert compare_module.world_notes([Policy("wander", Morphology.khepera_iii(), None)], paper) == []
 
 
+def test_compare_runs_in_the_world_a_champion_was_evolved_in(tmp_path, monkeypatch, capsys):
+    """gathering-compare --world-from CHAMPION takes the champion's world keys (here the force
+    drive and the shuffled schedule) and, unless given, its preset, steps and team size; with
+    --protocol as well it is refused in one line, exit 2, nothing written."""
+    from evolution import compare as compare_module
+
+    champion = json.loads((Path(__file__).resolve().parents[1] / "docs" / "evidence" / "original-S1-force"
+                           / "champion.json").read_text())
+    champion["environment"].update(schedule="shuffled", max_cycles=3000)
+    path = tmp_path / "champion.json"
+    path.write_text(json.dumps(champion))
+    seen = []
+
+    def fake_compare(policies, env_config, seeds):
+        seen.append(env_config)
+        return [{"policy": p.name, "sensors": 1, "episodes": len(seeds), "ft_mean": 0.0, "ft_std": 0.0,
+                 "ft_se": None, "small": 0.0, "medium": 0.0, "large": 0.0, "finished": 0,
+                 "steps_to_finish": None} for p in policies]
+
+    monkeypatch.setattr(compare_module, "compare", fake_compare)
+    args = ["--policy", "wander", "--policy", f"champion:{path}", "--episodes", "1", "--world-from", str(path)]
+    assert compare_module.compare_main(args + ["--out", str(tmp_path / "a")]) == 0
+    assert compare_module.compare_main(args + ["--robots", "5", "--out", str(tmp_path / "b")]) == 0
+    own, fewer = seen
+    assert own == champion["environment"]
+    assert (own["drive_model"], own["schedule"], own["environment"], own["max_cycles"]) == ("force", "shuffled", 1, 3000)
+    assert fewer == {**champion["environment"], "num_robots": 5}
+    out = capsys.readouterr().out
+    assert "was made in another world" not in out and f"the world of {path}" in out
+    assert compare_module.compare_main(args + ["--protocol", "original", "--out", str(tmp_path / "c")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--world-from and --protocol" in err[0] and not (tmp_path / "c").exists()
+
+
 def test_a_second_compare_into_the_same_folder_is_refused(tmp_path, capsys):
     """One writer per gathering-compare --out: while another holds it, one line, exit 2, no file."""
     from evolution.compare import compare_main
