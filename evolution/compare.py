@@ -9,8 +9,9 @@ ft, blocks gathered by type, time to finish) and ``compare.png`` (a bar plot).
 zone 20 x 4, the pickup box at the robot's centre, the Khepera-like IR curve), where a champion of
 an ``S1-original`` run was evolved; the default is the paper's world. ``--world-from
 CHAMPION.json`` runs them in the world a champion was evolved in (its ``environment`` keys, such
-as ``drive_model`` or ``schedule``; also its preset, steps and team size unless
-``--environment``, ``--steps`` or ``--robots`` is given). A champion evolved in another world than the one
+as ``drive_model`` or ``schedule``, but not a one-layout run's ``layout_seed``: the episodes' seeds
+lay out fresh worlds; also its preset, steps and team size unless ``--environment``, ``--steps``
+or ``--robots`` is given). A champion evolved in another world than the one
 compared in is named in a note on standard output.
 
 Policies: ``evolution.policies`` (the names ``--policy`` takes are listed there).
@@ -78,12 +79,13 @@ def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]
 
 def world_notes(policies: list[Policy], env_config: dict[str, Any]) -> list[str]:
     """One line per policy whose own world (a champion's ``environment``) differs from ``env_config``
-    in a key other than the ones a comparison sets on purpose (preset, steps, team size)."""
+    in a key other than the ones a comparison sets on purpose (preset, steps, team size, and the
+    layout: a one-layout run's ``layout_seed``)."""
     notes = []
     compared = WorldConfig.from_kwargs(**env_config)
     for policy in policies:
         own = {k: v for k, v in (policy.environment or {}).items()
-               if k not in ("environment", "max_cycles", "num_robots")}
+               if k not in ("environment", "max_cycles", "num_robots", "layout_seed")}
         changed = [f"{k} = {v!r} (here {getattr(compared, k)!r})" for k, v in sorted(own.items())
                    if hasattr(compared, k) and getattr(compared, k) != v]
         if changed:
@@ -163,7 +165,8 @@ def compare_main(argv: list[str] | None = None) -> int:
         raise UsageError("--world-from and --protocol both name the world; allowed: one of them")
     check_output_dir(args.out, (*COMPARE_FILES, LOCK_FILE))
     if args.world_from is not None:
-        world = make_policy(f"champion:{args.world_from}").environment or {}
+        world = dict(make_policy(f"champion:{args.world_from}").environment or {})
+        world.pop("layout_seed", None)   # a one-layout run's layout: compared on fresh ones
         where = f", the world of {args.world_from}"
     else:
         world = protocol_values(args.protocol or "paper")["environment"]

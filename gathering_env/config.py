@@ -104,8 +104,14 @@ class WorldConfig:
     """When each robot's drive acts, relative to the physics step: 'fixed' (every robot, then
     the physics step) or 'shuffled' (the original code's MASON schedule, which shuffles the
     robots and the physics step every step, so a robot's drive reaches a physics step 0, 1 or
-    2 times; drawn from the episode's seed; ``drive_model = 'force'`` only;
+    2 times; drawn from the reset seed, apart from the layout's draws; ``drive_model = 'force'`` only;
     ``gathering_env.drive.shuffled_times``)."""
+    layout_seed: int | None = None
+    """If set, every episode lays out its robots and blocks (positions and headings) from this
+    seed, whatever the reset seed; the reset seed then drives only the rest (the shuffled
+    schedule). One layout, several schedules: how the original's trials of one run differ
+    (``layout = "per_run"`` with ``schedule = "shuffled"``). None (default): the reset seed
+    draws the layout."""
 
     # --- blocks (index 0/1/2 = small/medium/large) ------------------------------------
     block_counts: tuple[int, int, int] = ENVIRONMENT_PRESETS[2]
@@ -274,6 +280,8 @@ class WorldConfig:
         if self.drive_model == "force" and self.drive_dead_band != 0.0:
             raise ValueError(f"drive_dead_band={self.drive_dead_band!r} with drive_model='force': "
                              "the force drive has its own dead band; allowed: 0")
+        if self.layout_seed is not None:
+            _check_int("layout_seed", self.layout_seed, 0, 2 ** 63 - 1)
         if self.schedule not in SCHEDULES:
             raise ValueError(f"schedule={self.schedule!r}; allowed: {', '.join(map(repr, SCHEDULES))}")
         if self.schedule == "shuffled" and self.drive_model != "force":

@@ -82,7 +82,8 @@ class GatheringWorld:
 
     # ------------------------------------------------------------------ construction
     def reset(self, rng: np.random.Generator) -> None:
-        """Build a fresh world with positions and headings drawn from ``rng``."""
+        """Build a fresh world with positions and headings drawn from ``rng`` (or, if the
+        config sets ``layout_seed``, from that seed) and the shuffled schedule from ``rng``."""
         cfg = self.config
         space = pymunk.Space()
         space.gravity = (0.0, 0.0)
@@ -99,9 +100,10 @@ class GatheringWorld:
         self.block_half = 0.5 * np.asarray(cfg.block_sizes, dtype=float)[types]
         self.block_need = np.asarray(cfg.robots_needed, dtype=np.int64)[types]
         self.block_value = np.asarray(cfg.block_values, dtype=float)[types]
-        block_xy, robot_xy = lay_out(cfg, self.block_half, rng)
-        block_angles = rng.uniform(-math.pi, math.pi, size=len(types))
-        robot_angles = rng.uniform(-math.pi, math.pi, size=cfg.num_robots)
+        layout_rng = rng if cfg.layout_seed is None else np.random.default_rng(cfg.layout_seed)
+        block_xy, robot_xy = lay_out(cfg, self.block_half, layout_rng)
+        block_angles = layout_rng.uniform(-math.pi, math.pi, size=len(types))
+        robot_angles = layout_rng.uniform(-math.pi, math.pi, size=cfg.num_robots)
 
         self.robot_bodies: list[pymunk.Body] = []
         robot_shapes: list[pymunk.Shape] = []
@@ -158,8 +160,9 @@ class GatheringWorld:
         self.block_sticky_side = np.full(b, -1, dtype=np.int64)
         self.anchor_owner = np.full((b, self.anchor_slots), -1, dtype=np.int64)
         self._welds: dict[int, tuple[pymunk.Constraint, pymunk.Constraint]] = {}
-        # The shuffled schedule's own generator, drawn after the layout (which it leaves alone).
-        self._schedule_rng = np.random.default_rng(rng.integers(2 ** 63)) if cfg.schedule == "shuffled" else None
+        # The shuffled schedule's own generator: a child of rng's seed, so it does not depend on
+        # the layout's draws (the same with and without layout_seed) and leaves them alone.
+        self._schedule_rng = rng.spawn(1)[0] if cfg.schedule == "shuffled" else None
         self._acted_after = np.zeros(n, dtype=bool)
         self.read_state()
 

@@ -191,6 +191,9 @@ def test_the_shuffled_schedule_is_refused_without_the_force_drive_and_unknown_na
         WorldConfig.from_kwargs(1, schedule="shuffled")
     with pytest.raises(ValueError, match="schedule='mason'; allowed: 'fixed', 'shuffled'"):
         WorldConfig.from_kwargs(1, drive_model="force", schedule="mason")
+    for bad in (-1, 2.5, True, "3"):
+        with pytest.raises(ValueError, match="layout_seed="):
+            WorldConfig.from_kwargs(1, layout_seed=bad)
 
 
 @pytest.mark.usefixtures("both_kernels")

@@ -630,3 +630,64 @@ def test_encogs_stagnation_spares_the_best_genomes_species_only():
     assert population.reproduction.best.key == best
     assert set(population.species.species) == {1}
     assert len(new) == 20 and best in new
+
+
+# ---------------------------------------------------------------------------- shuffled trials
+def test_under_the_shuffled_schedule_a_one_layout_runs_trials_share_the_layout_not_the_schedule():
+    from evolution.run.evaluate import training_environment, varied_episodes
+
+    shuffled = {"environment": 1, "drive_model": "force", "schedule": "shuffled"}
+    assert varied_episodes(shuffled) and not varied_episodes({"drive_model": "force"})
+    for generation in (0, 3):
+        assert episode_seeds(7, generation, 5, "per_run", shuffled) == [trial_seed(7, 0, t) for t in range(5)]
+        assert episode_seeds(7, generation, 5, "per_run", {"environment": 1}) == [trial_seed(7, 0, 0)]
+        assert episode_seeds(7, generation, 5, "per_trial", shuffled) == [trial_seed(7, generation, t) for t in range(5)]
+    assert training_environment(shuffled, 7, "per_run") == {**shuffled, "layout_seed": trial_seed(7, 0, 0)}
+    assert training_environment(shuffled, 7, "per_trial") == shuffled
+    assert training_environment({"environment": 1}, 7, "per_run") == {"environment": 1}
+    # the worlds: one layout (bodies where they start), episodes apart after a few steps
+    from gathering_env.vector import VectorSimulation
+
+    world = {**training_environment(shuffled, 7, "per_run"), "num_robots": 6, "max_cycles": 50}
+    sims = VectorSimulation(3, **world)
+    sims.reset(episode_seeds(7, 0, 3, "per_run", world))
+    start = [w.raw.copy() for w in sims._engine.worlds]
+    assert all(np.array_equal(start[0], s) for s in start[1:])
+    for _ in range(30):
+        sims.step(np.ones((3, 6, 2)))
+    moved = [w.robot_pos.copy() for w in sims._engine.worlds]
+    assert not np.array_equal(moved[0], moved[1]) and not np.array_equal(moved[1], moved[2])
+
+
+def test_a_shuffled_one_layout_champion_replays_each_training_trial_exactly(tmp_path, capsys):
+    """The champion of a per_run run under the shuffled schedule keeps the run's layout_seed and
+    its trials' seeds: replayed with each, it scores that trial's ft, whose mean is its training
+    ft; the trials differ (the record's trial_ft); a resumed run equals an unbroken one."""
+    from small_runs import evolve, experiment_file
+
+    from evolution.cli import replay_main
+    from evolution.run.champion import load_champion
+
+    exp = experiment_file(tmp_path, "shuffled", "hyperneat-m", '["task"]', generations=3,
+                          extra='layout = "per_run"\nelitism = "ratchet"\nconvergence_stop = false')
+    exp.write_text(exp.read_text().replace("max_cycles = 80", "max_cycles = 300")
+                   + 'drive_model = "force"\ndamping = 0.1\nschedule = "shuffled"\n')
+    evolve(exp, tmp_path / "run")
+    champ = load_champion(tmp_path / "run" / "champion.json")
+    seeds = (trial_seed(3, 0, 0), trial_seed(3, 0, 1))
+    assert champ.trial_seeds == seeds and champ.environment["layout_seed"] == seeds[0]
+    records = read_stats(tmp_path / "run" / "stats.jsonl")
+    trial_fts = [fts for r in records for fts in r["trial_ft"].values()]
+    assert all(len(fts) == 2 for fts in trial_fts) and any(a != b for a, b in trial_fts)
+    replayed = []
+    for seed in seeds:
+        capsys.readouterr()
+        assert replay_main([str(tmp_path / "run" / "champion.json"), "--seed", str(seed),
+                            "--out", str(tmp_path / f"t{seed}.gif")]) == 0
+        lines = capsys.readouterr().out.splitlines()
+        replayed.append(float(lines[0].split("ft = ")[1].split()[0].rstrip(",")))
+        assert lines[1].startswith(f"one of its 2 training episodes (seed {seed})")
+    assert np.mean(replayed) == pytest.approx(champ.objectives["task"], abs=0.01)
+    evolve(exp, tmp_path / "part", "--generations", "2")
+    evolve(exp, tmp_path / "part", "--resume")
+    assert without_work(read_stats(tmp_path / "part" / "stats.jsonl")) == without_work(records)

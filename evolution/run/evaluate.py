@@ -9,7 +9,10 @@ Trial seeds are derived from (run seed, generation, trial index) only, so every 
 a generation meets the same worlds and a result does not depend on which process ran it.
 With ``layout = "per_run"`` (the original code) every trial of every generation has the
 seed of (run seed, 0, 0): the simulation is deterministic, so the trials would be the same
-episode, and it is run once (``episode_seeds``).
+episode, and it is run once (``episode_seeds``). Under the shuffled schedule (``schedule =
+"shuffled"``) episodes of one layout differ, as the original's trials did: the run's layout is
+then fixed by the world's ``layout_seed`` (the seed of (run seed, 0, 0); ``training_environment``)
+and trial t runs with the seed of (run seed, 0, t), which drives only its schedule.
 """
 
 from __future__ import annotations
@@ -31,14 +34,31 @@ def trial_seed(run_seed: int, generation: int, trial: int) -> int:
     return int(np.random.SeedSequence([int(run_seed), int(generation), int(trial)]).generate_state(1)[0])
 
 
-def episode_seeds(run_seed: int, generation: int, trials: int, layout: str = "per_trial") -> list[int]:
+def varied_episodes(environment: dict[str, Any] | None) -> bool:
+    """Whether two episodes of one layout can differ in this world: only under the shuffled
+    schedule (everything else in the simulator is deterministic)."""
+    return (environment or {}).get("schedule", "fixed") == "shuffled"
+
+
+def episode_seeds(run_seed: int, generation: int, trials: int, layout: str = "per_trial",
+                  environment: dict[str, Any] | None = None) -> list[int]:
     """The seeds of the episodes a genome of ``generation`` runs: one per trial, or with
-    ``layout = "per_run"`` the run's single layout, once (its trials would be identical)."""
+    ``layout = "per_run"`` the run's single layout, once (its trials would be identical), unless
+    the world's episodes vary (``varied_episodes``): then one per trial, of generation 0."""
     if layout == "per_run":
-        return [trial_seed(run_seed, 0, 0)]
+        return [trial_seed(run_seed, 0, trial) for trial in range(trials if varied_episodes(environment) else 1)]
     if layout != "per_trial":
         raise ValueError(f"layout={layout!r}; allowed: 'per_trial', 'per_run'")
     return [trial_seed(run_seed, generation, trial) for trial in range(trials)]
+
+
+def training_environment(environment: dict[str, Any], run_seed: int, layout: str) -> dict[str, Any]:
+    """The world a run's genomes are evaluated in: ``environment``, and with ``layout =
+    "per_run"`` in a world whose episodes vary, ``layout_seed`` fixed to the run's layout, so
+    the trials share it and differ by their schedules."""
+    if layout == "per_run" and varied_episodes(environment):
+        return {**environment, "layout_seed": trial_seed(run_seed, 0, 0)}
+    return dict(environment)
 
 
 def decode_genome(method: str, genome: Any, config: Any, substrate: Any = None):
@@ -140,7 +160,8 @@ def evaluate(genome: Any, config: Any, env_config: dict[str, Any], trials: int =
 
     Args:
         genome: a neat-python genome of the method's genome class. config: its ``neat.Config``.
-        env_config: keyword arguments of ``gathering_env.parallel_env``.
+        env_config: keyword arguments of ``gathering_env.parallel_env`` (a run's
+            ``training_environment``).
         trials: episodes; the task objective is the mean ft. seed: the run seed.
         generation: used with ``seed`` to derive the trial seeds. layout: ``episode_seeds``.
         complexity: the formula of eq. 2 (``gathering_env.morphological_complexity``).
@@ -151,7 +172,7 @@ def evaluate(genome: Any, config: Any, env_config: dict[str, Any], trials: int =
     t0 = time.perf_counter()
     controller, morphology = decode_genome(method, genome, config, substrate)
     t_decode = time.perf_counter() - t0
-    seeds = episode_seeds(seed, generation, trials, layout)
+    seeds = episode_seeds(seed, generation, trials, layout, env_config)
     sims = _worlds_for(env_config, len(seeds))
     fts, total_steps, t_env, t_ctrl = run_trials(sims, controller, morphology, seeds)
     return scored(controller, morphology, fts, complexity, steps=total_steps, seconds_env=t_env,

@@ -20,7 +20,7 @@ import neat
 
 from evolution.run.champion import save_champion
 from evolution.run.checkpoint import atomic_write_bytes, save_checkpoint
-from evolution.run.evaluate import Evaluation, decode_genome, episode_seeds
+from evolution.run.evaluate import Evaluation, decode_genome, episode_seeds, training_environment
 from evolution.run.experiment import Experiment
 from evolution.run.stats import append_stats, generation_record, write_stats
 from gathering_env import morphological_complexity as morphology_simplicity
@@ -139,8 +139,8 @@ class RunRecorder:
                       genome=genome, morphology=morphology, controller=controller,
                       objectives={"task": evaluation.task, "morphology": evaluation.morphology,
                                   "controller": evaluation.controller},
-                      environment=exp.environment,
-                      trial_seeds=episode_seeds(exp.seed, generation, exp.trials, exp.layout))
+                      environment=training_environment(exp.environment, exp.seed, exp.layout),
+                      trial_seeds=episode_seeds(exp.seed, generation, exp.trials, exp.layout, exp.environment))
 
     def write_front(self, population: neat.Population) -> None:
         """Write every genome of the final first front as a JSON champion in ``front/``."""

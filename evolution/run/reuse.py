@@ -49,7 +49,7 @@ class ReusingEvaluator:
 
     def map(self, genomes: list[Any], generation: int) -> list[Evaluation]:
         ctx = self.context
-        seeds = tuple(episode_seeds(ctx.seed, generation, ctx.trials, ctx.layout))
+        seeds = tuple(episode_seeds(ctx.seed, generation, ctx.trials, ctx.layout, ctx.env_config))
         if any(k[1] != seeds for k in self._store):  # fresh layouts: last generation's teams never recur
             self._store = {k: v for k, v in self._store.items() if k[1] == seeds}
         keys = [(team_key(*decode_genome(ctx.method, g, ctx.neat_config, ctx.substrate)), seeds) for g in genomes]

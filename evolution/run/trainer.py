@@ -32,7 +32,7 @@ import neat
 
 from evolution.guard import UsageError, describe_os_error, writing
 from evolution.run.backends import EvalContext, make_evaluator
-from evolution.run.evaluate import Evaluation
+from evolution.run.evaluate import Evaluation, training_environment, varied_episodes
 from evolution.run.experiment import Experiment
 from evolution.run.lock import RunLock
 from evolution.run.rebuild import RebuildingEvaluator, load_record
@@ -62,7 +62,10 @@ def protocol_notes(exp: Experiment) -> list[str]:
     notes = []
     if exp.protocol is not None:
         notes.append(f"{exp.name}: protocol {exp.protocol!r}")
-    if exp.layout == "per_run":
+    if exp.layout == "per_run" and varied_episodes(exp.environment):
+        notes.append(f"{exp.name}: one layout for the whole run (layout = per_run): its {exp.trials} trials share it "
+                     "and differ by their shuffled schedules (schedule = shuffled), as the original's did")
+    elif exp.layout == "per_run":
         notes.append(f"{exp.name}: one layout for the whole run (layout = per_run): its {exp.trials} trials would be "
                      "the same episode in this deterministic simulator, so each genome runs it once")
     if exp.elitism == "ratchet" and not exp.multi_objective:
@@ -182,7 +185,8 @@ class Trainer:
             return self._result(recorder.converged(), already_finished=True)
         converged = False
         recorded = load_record(self.rebuild_from, exp.to_dict()) if self.rebuild_from is not None else None
-        context = EvalContext(recorder.config, dict(exp.environment), exp.trials, exp.seed, exp.method,
+        context = EvalContext(recorder.config, training_environment(exp.environment, exp.seed, exp.layout),
+                              exp.trials, exp.seed, exp.method,
                               recorder.substrate, layout=exp.layout, complexity=exp.complexity)
         for line in protocol_notes(exp):
             print(line, flush=True)
