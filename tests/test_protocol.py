@@ -691,3 +691,18 @@ def test_a_shuffled_one_layout_champion_replays_each_training_trial_exactly(tmp_
     evolve(exp, tmp_path / "part", "--generations", "2")
     evolve(exp, tmp_path / "part", "--resume")
     assert without_work(read_stats(tmp_path / "part" / "stats.jsonl")) == without_work(records)
+
+
+def test_a_one_layout_run_says_how_its_trials_are_run():
+    from dataclasses import replace
+
+    from evolution.run.trainer import protocol_notes
+
+    exp = load_experiment(*resolve_preset("S1-original"))
+    shuffled = {**exp.environment, "drive_model": "force", "robot_drive_force": 1.0, "schedule": "shuffled"}
+    lines = {name: next(n for n in protocol_notes(e) if "one layout" in n) for name, e in (
+        ("fixed", exp), ("shuffled", replace(exp, environment=shuffled)),
+        ("one", replace(exp, environment=shuffled, trials=1)))}
+    assert "would be the same episode" in lines["fixed"] and "runs it once" in lines["fixed"]
+    assert "its 5 trials share it and differ by their shuffled schedules" in lines["shuffled"]
+    assert "one trial on it with one shuffled schedule" in lines["one"]

@@ -62,7 +62,10 @@ def protocol_notes(exp: Experiment) -> list[str]:
     notes = []
     if exp.protocol is not None:
         notes.append(f"{exp.name}: protocol {exp.protocol!r}")
-    if exp.layout == "per_run" and varied_episodes(exp.environment):
+    if exp.layout == "per_run" and varied_episodes(exp.environment) and exp.trials == 1:
+        notes.append(f"{exp.name}: one layout for the whole run (layout = per_run), one trial on it with one "
+                     "shuffled schedule (schedule = shuffled), the same for every genome")
+    elif exp.layout == "per_run" and varied_episodes(exp.environment):
         notes.append(f"{exp.name}: one layout for the whole run (layout = per_run): its {exp.trials} trials share it "
                      "and differ by their shuffled schedules (schedule = shuffled), as the original's did")
     elif exp.layout == "per_run":
