@@ -8,7 +8,7 @@ trials, one process. The controller runs **inside the timed region**, as it does
 Java measurement it is compared with.
 
     python benchmarks/bench_env.py [--steps 10000] [--repeats 3] [--kernels compiled,numpy]
-                                   [--java STEPS_PER_S]
+                                   [--drive velocity|force|shuffled] [--java STEPS_PER_S]
 
 Prints, for each kernel, the best of ``--repeats`` runs of:
 * the PettingZoo parallel API (dict actions and observations),
@@ -38,12 +38,15 @@ import time
 import numpy as np
 
 from evolution.policies.scripted import WanderTeam
+from evolution.run.protocol import ORIGINAL_FORCE_DRIVE, ORIGINAL_SCHEDULE
 from gathering_env import Morphology, SensorSpec, parallel_env
 from gathering_env.compiled.kernels import CompiledSensorBank
 from gathering_env.reference.sensing import SensorBank
 from gathering_env.vector import VectorSimulation
 
 ENV = dict(environment=2, num_robots=20)
+#: ``--drive``: the robot drive timed (``gathering_env.drive``); the default is the paper's.
+DRIVES = {"velocity": {}, "force": ORIGINAL_FORCE_DRIVE, "shuffled": {**ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE}}
 JAVA_SIDE_BY_SIDE = ("measured 2026-11, one session, controller included on both sides: fast path 1.9x the Java, "
                      "PettingZoo API 1.26x, 16 worlds per call 2.8x per world; Java 12 800 steps/s that day "
                      "(a quoted measurement, not recomputed here; --java compares with today's)")
@@ -153,16 +156,20 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=10_000, help="steps per timed run (default 10000)")
     parser.add_argument("--repeats", type=int, default=3, help="timed runs per path; the best is reported")
     parser.add_argument("--kernels", default="compiled,numpy", help="comma-separated kernels to time")
+    parser.add_argument("--drive", choices=DRIVES, default="velocity",
+                        help="robot drive: velocity (the paper's, default), force (the original robot) or "
+                             "shuffled (the force drive under the original's shuffled schedule)")
     parser.add_argument("--java", type=float, default=None, metavar="STEPS_PER_S",
                         help="the Java original's steps/s measured the same day: also print each path "
                              "as a multiple of it")
     args = parser.parse_args()
     if args.java is not None and not args.java > 0:
         parser.error(f"--java {args.java}: allowed: a number of steps per second > 0")
+    ENV.update(DRIVES[args.drive])
     kernels = [k.strip() for k in args.kernels.split(",") if k.strip()]
     run_fast(kernels[0], 50)  # compile or load the kernels before timing
-    print(f"collective gathering, environment 2, 20 robots, Khepera III, pickup on, wander team "
-          f"(timed with the steps), {args.steps} steps, best of {args.repeats}")
+    print(f"collective gathering, environment 2, 20 robots, Khepera III, pickup on, {args.drive} drive, wander "
+          f"team (timed with the steps), {args.steps} steps, best of {args.repeats}")
     yard = args.steps / min(run_yardstick(args.steps) for _ in range(args.repeats))
     print(f"yardstick: bare pymunk step of the same world, {yard:.0f} steps/s (this process, now)")
     java = f"{'vs Java':>10}" if args.java else ""

@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from evolution.guard import ArgumentParser, command
-from evolution.run.protocol import ORIGINAL_FORCE_DRIVE, ORIGINAL_PHYSICS, protocol_values
+from evolution.run.protocol import ORIGINAL_FORCE_DRIVE, ORIGINAL_PHYSICS, ORIGINAL_SCHEDULE, protocol_values
 from gathering_env.config import WorldConfig
 from gathering_env.simulation import GatheringSimulation
 
@@ -60,7 +60,7 @@ def physics(world: str) -> dict:
             del keys[key]
         keys.update(ORIGINAL_FORCE_DRIVE)
     if world == "shuffled":
-        keys["schedule"] = "shuffled"
+        keys.update(ORIGINAL_SCHEDULE)
     return keys
 
 

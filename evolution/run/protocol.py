@@ -72,6 +72,10 @@ ORIGINAL_PHYSICS = ("ground_friction", "robot_restitution", "block_restitution",
 #: velocity drive's three keys: ``robot_drive_force``, ``robot_max_speed``, ``drive_dead_band``.
 ORIGINAL_FORCE_DRIVE = {"drive_model": "force", "damping": 0.1}
 
+#: The original's MASON schedule on top of the force drive (not part of the bundle either):
+#: robots and the physics step shuffled every step (``gathering_env.drive.shuffled_times``).
+ORIGINAL_SCHEDULE = {"schedule": "shuffled"}
+
 PROTOCOLS = ("paper", "original")
 
 #: One line per protocol, for ``gathering-evolve --list``.
@@ -135,4 +139,4 @@ def apply_protocol(name: str, sections: dict[str, dict[str, Any]], source: str,
             target[key] = list(value) if isinstance(value, list) else value
 
 
-__all__ = ["DESCRIPTIONS", "ORIGINAL", "ORIGINAL_FORCE_DRIVE", "ORIGINAL_PHYSICS", "PROTOCOLS", "apply_protocol", "protocol_values"]
+__all__ = ["DESCRIPTIONS", "ORIGINAL", "ORIGINAL_FORCE_DRIVE", "ORIGINAL_PHYSICS", "ORIGINAL_SCHEDULE", "PROTOCOLS", "apply_protocol", "protocol_values"]
