@@ -469,6 +469,18 @@ def test_the_paper_protocols_species_keep_neat_pythons_selection():
     assert config.stagnation_config.max_stagnation == 20
 
 
+def _recording_compare(seen: list):
+    """A stand-in for ``evolution.compare.compare`` that records the world it is asked for."""
+
+    def fake_compare(policies, env_config, seeds):
+        seen.append(env_config)
+        return [{"policy": p.name, "sensors": 1, "episodes": len(seeds), "ft_mean": 0.0, "ft_std": 0.0,
+                 "ft_se": None, "small": 0.0, "medium": 0.0, "large": 0.0, "finished": 0,
+                 "steps_to_finish": None} for p in policies]
+
+    return fake_compare
+
+
 def test_compare_runs_in_the_protocols_world(tmp_path, monkeypatch, capsys):
     """gathering-compare --protocol original compares in the original world (zone 4 deep, centre
     box, Khepera-like IR), the default in the paper's; a champion made in another world is named."""
@@ -477,13 +489,7 @@ def test_compare_runs_in_the_protocols_world(tmp_path, monkeypatch, capsys):
 
     seen = []
 
-    def fake_compare(policies, env_config, seeds):
-        seen.append(env_config)
-        return [{"policy": p.name, "sensors": 1, "episodes": len(seeds), "ft_mean": 0.0, "ft_std": 0.0,
-                 "ft_se": None, "small": 0.0, "medium": 0.0, "large": 0.0, "finished": 0,
-                 "steps_to_finish": None} for p in policies]
-
-    monkeypatch.setattr(compare_module, "compare", fake_compare)
+    monkeypatch.setattr(compare_module, "compare", _recording_compare(seen))
     for protocol, out in (("original", "o"), ("paper", "p")):
         assert compare_module.compare_main(["--policy", "wander", "--episodes", "1", "--protocol", protocol,
                                             "--out", str(tmp_path / out)]) == 0
@@ -512,13 +518,7 @@ def test_compare_runs_in_the_world_a_champion_was_evolved_in(tmp_path, monkeypat
     path.write_text(json.dumps(champion))
     seen = []
 
-    def fake_compare(policies, env_config, seeds):
-        seen.append(env_config)
-        return [{"policy": p.name, "sensors": 1, "episodes": len(seeds), "ft_mean": 0.0, "ft_std": 0.0,
-                 "ft_se": None, "small": 0.0, "medium": 0.0, "large": 0.0, "finished": 0,
-                 "steps_to_finish": None} for p in policies]
-
-    monkeypatch.setattr(compare_module, "compare", fake_compare)
+    monkeypatch.setattr(compare_module, "compare", _recording_compare(seen))
     args = ["--policy", "wander", "--policy", f"champion:{path}", "--episodes", "1", "--world-from", str(path)]
     assert compare_module.compare_main(args + ["--out", str(tmp_path / "a")]) == 0
     assert compare_module.compare_main(args + ["--robots", "5", "--out", str(tmp_path / "b")]) == 0
