@@ -10,8 +10,9 @@ zone 20 x 4, the pickup box at the robot's centre, the Khepera-like IR curve), w
 an ``S1-original`` run was evolved; the default is the paper's world. ``--world-from
 CHAMPION.json`` runs them in the world a champion was evolved in (its ``environment`` keys, such
 as ``drive_model`` or ``schedule``, but not a one-layout run's ``layout_seed``: the episodes' seeds
-lay out fresh worlds; also its preset, steps and team size unless ``--environment``, ``--steps``
-or ``--robots`` is given). A champion evolved in another world than the one
+lay out fresh worlds (with ``--own-layout`` they keep it, and the seeds vary only the shuffled
+schedule: how robust a one-layout champion is on its own layout); also its preset, steps and team
+size unless ``--environment``, ``--steps`` or ``--robots`` is given). A champion evolved in another world than the one
 compared in is named in a note on standard output.
 
 Policies: ``evolution.policies`` (the names ``--policy`` takes are listed there).
@@ -158,16 +159,25 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--world-from", type=Path, metavar="CHAMPION",
                         help="the world a champion.json was evolved in (its environment keys; its preset, "
                              "steps and team size unless given); not with --protocol")
+    parser.add_argument("--own-layout", action="store_true",
+                        help="with --world-from a one-layout run's champion under the shuffled schedule: keep "
+                             "its layout (layout_seed); the episodes' seeds then vary only the schedule")
     parser.add_argument("--out", type=Path, default=Path("compare"),
                         help="folder for compare.md, compare.csv, compare.png (default compare/)")
     args = parser.parse_args(argv)
     if args.world_from is not None and args.protocol is not None:
         raise UsageError("--world-from and --protocol both name the world; allowed: one of them")
     check_output_dir(args.out, (*COMPARE_FILES, LOCK_FILE))
+    if args.own_layout and args.world_from is None:
+        raise UsageError("--own-layout: keeps the layout of --world-from's champion; allowed: with --world-from")
     if args.world_from is not None:
         world = dict(make_policy(f"champion:{args.world_from}").environment or {})
-        world.pop("layout_seed", None)   # a one-layout run's layout: compared on fresh ones
-        where = f", the world of {args.world_from}"
+        if args.own_layout and "layout_seed" not in world:
+            raise UsageError(f"--own-layout: {args.world_from} has no layout_seed (not a one-layout run under the "
+                             "shuffled schedule); allowed: such a champion, or no --own-layout")
+        if not args.own_layout:
+            world.pop("layout_seed", None)   # a one-layout run's layout: compared on fresh ones
+        where = f", the world of {args.world_from}{' on its own layout' if args.own_layout else ''}"
     else:
         world = protocol_values(args.protocol or "paper")["environment"]
         where = ", original protocol" if args.protocol == "original" else ""

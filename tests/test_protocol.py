@@ -528,6 +528,18 @@ def test_compare_runs_in_the_world_a_champion_was_evolved_in(tmp_path, monkeypat
     assert fewer == {**champion["environment"], "num_robots": 5}
     out = capsys.readouterr().out
     assert "was made in another world" not in out and f"the world of {path}" in out
+    assert compare_module.compare_main(args + ["--own-layout", "--out", str(tmp_path / "g")]) == 2
+    assert "has no layout_seed" in capsys.readouterr().err and not (tmp_path / "g").exists()
+    # a one-layout champion: compared on fresh layouts, or with --own-layout on its own
+    champion["environment"]["layout_seed"] = 99
+    path.write_text(json.dumps(champion))
+    assert compare_module.compare_main(args + ["--out", str(tmp_path / "d")]) == 0
+    assert compare_module.compare_main(args + ["--own-layout", "--out", str(tmp_path / "e")]) == 0
+    fresh, own_layout = seen[2:]
+    assert "layout_seed" not in fresh and own_layout["layout_seed"] == 99
+    assert "on its own layout" in (tmp_path / "e" / "compare.md").read_text()
+    assert compare_module.compare_main(["--own-layout", "--policy", "wander", "--out", str(tmp_path / "f")]) == 2
+    assert "allowed: with --world-from" in capsys.readouterr().err
     assert compare_module.compare_main(args + ["--protocol", "original", "--out", str(tmp_path / "c")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--world-from and --protocol" in err[0] and not (tmp_path / "c").exists()
