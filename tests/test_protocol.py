@@ -718,3 +718,13 @@ def test_a_one_layout_run_says_how_its_trials_are_run():
     assert "would be the same episode" in lines["fixed"] and "runs it once" in lines["fixed"]
     assert "its 5 trials share it and differ by their shuffled schedules" in lines["shuffled"]
     assert "one trial on it with one shuffled schedule" in lines["one"]
+
+
+def test_a_one_layout_run_refuses_a_layout_seed_of_its_own(tmp_path):
+    path = experiment(tmp_path, body='layout = "per_run"')
+    path.write_text(path.read_text() + "layout_seed = 4\n")
+    with pytest.raises(ExperimentError, match=r"layout_seed with \[experiment\] layout = 'per_run'"):
+        load_experiment(path)
+    path = experiment(tmp_path, name="fresh", body="")
+    path.write_text(path.read_text() + "layout_seed = 4\n")
+    assert load_experiment(path).world_config().layout_seed == 4

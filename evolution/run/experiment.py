@@ -364,6 +364,9 @@ def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str,
     if need_neat_config and not neat_path.is_file():
         raise ExperimentError(f"{source}: [experiment] neat_config: file {neat_path} not found")
     values["neat_config"] = neat_path
+    if "layout_seed" in env_section and values.get("layout", "per_trial") == "per_run":
+        raise ExperimentError(f"{source}: [environment] layout_seed with [experiment] layout = 'per_run': the run "
+                              "lays out its one layout from its seed; allowed: no layout_seed, or layout = 'per_trial'")
     try:
         world = WorldConfig.from_kwargs(**env_section)
         GatheringWorld.check_placement(world)  # an impossible world fails now, not in every evaluation

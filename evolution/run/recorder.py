@@ -159,7 +159,8 @@ class RunRecorder:
             values.setdefault("controller", 100.0 - float(controller.num_links))
             save_champion(front_dir / f"genome-{key}.json", method=exp.method, experiment=exp.name,
                           generation=generation, genome=genome, morphology=morphology,
-                          controller=controller, objectives=values, environment=exp.environment)
+                          controller=controller, objectives=values,
+                          environment=training_environment(exp.environment, exp.seed, exp.layout))
 
     def plot(self) -> None:
         from evolution.run.plots import plot_run
