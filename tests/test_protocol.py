@@ -20,7 +20,7 @@ from evolution.run.protocol import ORIGINAL, protocol_values
 from evolution.run.recorder import convergence_target
 from evolution.run.stats import read_stats, without_work
 from gathering_env import Morphology, SensorSpec, morphological_complexity
-from gathering_env.compiled import kernels
+from gathering_env.compiled import kernels, settle
 from gathering_env.config import WorldConfig
 from gathering_env.reference.heuristics import pickup_candidates
 from gathering_env.simulation import GatheringSimulation
@@ -294,7 +294,7 @@ def _scene(gap, **box):
 def _compiled_box(sim):
     params, _ = kernels.world_params(sim.config)
     w = sim.world
-    return kernels._in_pickup_box(w.robot_pos[0, 0], w.robot_pos[0, 1], w.robot_angle[0], w.block_pos[0, 0],
+    return settle._in_pickup_box(w.robot_pos[0, 0], w.robot_pos[0, 1], w.robot_angle[0], w.block_pos[0, 0],
                                   w.block_pos[0, 1], w.block_angle[0], w.block_half[0], params)
 
 
