@@ -132,14 +132,24 @@ def make_original_s1(args: argparse.Namespace) -> None:
                      title="S1-original")
 
 
-def make_original_s1_continued(args: argparse.Namespace) -> None:
-    """The curve of the S1-original run continued across sessions, from its committed record
-    (``docs/evidence/original-S1-continued/stats.jsonl``)."""
+def record_curve(folder_name: str, title: str) -> None:
+    """``stats.png`` of a run kept going across sessions, drawn from its committed record
+    (``docs/evidence/<folder_name>/stats.jsonl``)."""
     from evolution.run.plots import plot_run
     from evolution.run.stats import read_stats
 
-    folder = DOCS / "evidence" / "original-S1-continued"
-    plot_run(read_stats(folder / "stats.jsonl"), folder / "stats.png", title="S1-original, continued")
+    folder = DOCS / "evidence" / folder_name
+    plot_run(read_stats(folder / "stats.jsonl"), folder / "stats.png", title=title)
+
+
+def make_original_s1_continued(args: argparse.Namespace) -> None:
+    """The S1-original run continued to generation 250 (the velocity drive)."""
+    record_curve("original-S1-continued", "S1-original, continued")
+
+
+def make_original_s1_shuffled(args: argparse.Namespace) -> None:
+    """The S1-original run under the force drive and the shuffled schedule."""
+    record_curve("original-S1-shuffled", "S1-original, force drive, shuffled schedule")
 
 
 LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
@@ -177,6 +187,8 @@ STEPS: dict[str, Step] = {
     "original-s1": Step(("evidence/original-S1/stats.png",), "original_s1", make_original_s1),
     "original-s1-continued": Step(("evidence/original-S1-continued/stats.png",), None,
                                   make_original_s1_continued),
+    "original-s1-shuffled": Step(("evidence/original-S1-shuffled/stats.png",), None,
+                                 make_original_s1_shuffled),
     "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
                       "evidence/learning/M1/stats.png"), "learning", make_learning),
 }
