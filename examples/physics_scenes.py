@@ -5,8 +5,8 @@ what the original's Java classes were measured doing in the same scene (its comp
 code, jbox2d, ``world.step(0.1, 6, 3)``; robots heading +y unless said; figures below as
 "fixed order / shuffled": every robot then the world, or MASON's shuffled schedule as the
 original runs, median of 20 seeds). Worlds compared: ``paper`` (this package's defaults),
-``original`` (the physics keys of ``protocol = "original"``: mass friction, Box2D
-restitution, the original robot's push and top speed) and ``force`` (the same with the
+``original`` (the physics keys of ``protocol = "original"``'s version 2: mass friction, Box2D
+restitution, the original robot's push and top speed on the velocity drive) and ``force`` (the same with the
 original's robot as ``drive_model = "force"`` models it: wheel forces, traction impulse, its
 own ground friction, Box2D damping 0.1) and ``shuffled`` (the force drive under MASON's shuffled
 schedule, ``schedule = "shuffled"``: the median over the schedules of seeds 0..19, as the
@@ -22,7 +22,13 @@ import math
 import numpy as np
 
 from evolution.guard import ArgumentParser, command
-from evolution.run.protocol import ORIGINAL_FORCE_DRIVE, ORIGINAL_PHYSICS, ORIGINAL_SCHEDULE, protocol_values
+from evolution.run.protocol import (
+    ORIGINAL_FORCE_DRIVE,
+    ORIGINAL_PHYSICS,
+    ORIGINAL_SCHEDULE,
+    ORIGINAL_VELOCITY_DRIVE,
+    protocol_values,
+)
 from gathering_env.config import WorldConfig
 from gathering_env.simulation import GatheringSimulation
 
@@ -53,10 +59,10 @@ def physics(world: str) -> dict:
     """World overrides of a compared world (pickup off in all)."""
     keys = {}
     if world in ("original", "force", "shuffled"):
-        env = protocol_values("original")["environment"]
+        env = protocol_values("original", 2)["environment"]  # version 2: the velocity drive's model
         keys = {key: env[key] for key in ORIGINAL_PHYSICS}
     if world in ("force", "shuffled"):
-        for key in ("robot_drive_force", "robot_max_speed", "drive_dead_band"):
+        for key in ORIGINAL_VELOCITY_DRIVE:
             del keys[key]
         keys.update(ORIGINAL_FORCE_DRIVE)
     if world == "shuffled":
@@ -141,8 +147,8 @@ def measure_once(world: str, seed: int) -> dict[str, float]:
 def main(argv: list[str] | None = None) -> int:
     ArgumentParser(description=__doc__.splitlines()[0]).parse_args(argv)
     ours = {world: measure(world) for world in ("paper", "original", "force", "shuffled")}
-    print("| scene | measured | original (fixed order / shuffled) | here, original protocol | here, paper "
-          "| here, force drive | here, force drive, shuffled |")
+    print("| scene | measured | original (fixed order / shuffled) | here, original protocol version 2 | here, paper "
+          "| here, force drive | here, force drive, shuffled (version 3) |")
     print("|---|---|---|---|---|---|---|")
     for scene, (what, fixed, shuffled) in ORIGINAL.items():
         print(f"| {scene} | {what} | {fixed:.3g} / {shuffled:.3g} | {ours['original'][scene]:.3g} "

@@ -122,7 +122,7 @@ def test_bad_physics_options_name_the_key_and_what_is_allowed(key, value, allowe
 def test_under_the_original_protocols_physics_one_robot_moves_a_medium_block_as_in_the_original():
     # Measured on the original's own classes: 7.3 (fixed order) to 17.1 (its shuffled
     # schedule) units in 500 steps; under the paper's world one robot cannot move it at all.
-    env = protocol_values("original")["environment"]
+    env = protocol_values("original", 2)["environment"]  # version 2: the velocity drive's model
     moved = push(1, steps=500, **{key: env[key] for key in ORIGINAL_PHYSICS})
     assert 5.0 < moved < 25.0
     assert push(1, steps=500) < 0.05
@@ -163,3 +163,16 @@ def test_the_fidelity_pages_pushing_table_is_what_the_scenes_measure_today():
         for scene, value in scenes.measure(world).items():
             row = next(line for line in page.splitlines() if line.startswith(f"| {scene} |"))
             assert row.split("|")[1 + column].strip() == f"{value:.3g}", (world, scene)
+
+
+def test_the_scenes_shuffled_world_is_the_physics_of_the_newest_bundle():
+    # the fidelity page's last column is what protocol = "original" (version 3) runs
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("physics_scenes", root / "examples" / "physics_scenes.py")
+    scenes = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(scenes)
+    newest = protocol_values("original")["environment"]
+    sensing = ("zone_depth", "pickup_box", "pickup_box_width", "pickup_box_depth", "ir_response")
+    assert scenes.physics("shuffled") == {k: v for k, v in newest.items() if k not in sensing}
+    version2 = protocol_values("original", 2)["environment"]
+    assert scenes.physics("original") == {k: v for k, v in version2.items() if k not in sensing}

@@ -15,7 +15,13 @@ from evolution.cli import evolve_main
 from evolution.encodings.substrate import Substrate
 from evolution.run import backends
 from evolution.run.evaluate import Evaluation, episode_seeds, trial_seed
-from evolution.run.experiment import ExperimentError, load_experiment, preset_text, resolve_preset
+from evolution.run.experiment import (
+    ExperimentError,
+    experiment_from_run,
+    load_experiment,
+    preset_text,
+    resolve_preset,
+)
 from evolution.run.protocol import ORIGINAL, protocol_values
 from evolution.run.recorder import convergence_target
 from evolution.run.stats import read_stats, without_work
@@ -132,6 +138,74 @@ def test_dumped_protocol_preset_loads_like_the_preset(tmp_path, capsys):
         {k: v for k, v in preset.to_dict().items() if k != "source"}
 
 
+# ---------------------------------------------------------------------------- versions
+EVIDENCE = Path(__file__).resolve().parents[1] / "docs" / "evidence"
+
+
+def test_the_versions_of_the_original_bundle():
+    v1, v2, v3 = (protocol_values("original", v)["environment"] for v in (1, 2, 3))
+    assert v1 == {"zone_depth": 4.0, "pickup_box": "centre", "pickup_box_width": 0.2, "pickup_box_depth": 0.1,
+                  "ir_response": "gamma"}
+    assert v2 == v1 | {"ground_friction": "mass", "robot_restitution": 1.0, "block_restitution": 0.4,
+                       "wall_restitution": 1.0, "robot_drive_force": 3.63, "robot_max_speed": 0.637,
+                       "drive_dead_band": 0.28}
+    assert v3 == {k: v for k, v in v2.items() if k not in ("robot_drive_force", "robot_max_speed", "drive_dead_band")} \
+        | {"drive_model": "force", "damping": 0.1, "schedule": "shuffled"}
+    assert protocol_values("original") == protocol_values("original", 3) and ORIGINAL["environment"] == v3
+    # "paper" names the defaults of every key any version sets
+    paper = protocol_values("paper")["environment"]
+    assert (paper["drive_model"], paper["damping"], paper["schedule"], paper["drive_dead_band"],
+            paper["robot_max_speed"], paper["ground_friction"]) == ("velocity", 0.0, "fixed", 0.0, 0.5, "threshold")
+
+
+@pytest.mark.parametrize("version", [1, 2, 3])
+def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path, version):
+    exp = load_experiment(experiment(tmp_path, body=f'protocol = "original"\nprotocol_version = {version}'))
+    saved = exp.to_dict()
+    assert saved["protocol_version"] == version
+    del saved["protocol_version"]                   # experiment.json as it was written before versions
+    again = experiment_from_run(saved, "experiment.json")
+    assert again.protocol_version == version and again.environment == exp.environment
+    assert again.world_config() == exp.world_config()
+
+
+@pytest.mark.parametrize("folder, version", [("original-S1-2018", 1), ("original-S1-elite02", 1),
+                                             ("original-S1", 2), ("original-S1-continued", 2), ("original-M1", 2)])
+def test_the_committed_records_rebuild_in_the_world_they_were_run_in(folder, version):
+    saved = json.loads((EVIDENCE / folder / "experiment.json").read_text())
+    assert "protocol_version" not in saved and saved["protocol"] == "original"
+    exp = experiment_from_run(saved, folder)
+    assert exp.protocol_version == version and exp.environment == saved["environment"]
+    assert (exp.world_config().drive_model, exp.world_config().schedule) == ("velocity", "fixed")
+
+
+def test_the_five_schedule_record_is_the_s1_original_preset():
+    record = load_experiment(EVIDENCE / "original-S1-five" / "experiment.toml")
+    preset = load_experiment(*resolve_preset("S1-original"))
+    assert (record.protocol, preset.protocol_version) == (None, 3)
+    mine = {k: v for k, v in record.to_dict().items() if k not in ("name", "source", "protocol", "protocol_version")}
+    theirs = {k: v for k, v in preset.to_dict().items() if k not in ("name", "source", "protocol", "protocol_version")}
+    assert mine == theirs
+
+
+@pytest.mark.parametrize("body, needle", [
+    ('protocol = "original"\nprotocol_version = 7', "[experiment] protocol_version=7; allowed for protocol = "
+                                                     "'original': [1, 2, 3]"),
+    ('protocol = "original"\nprotocol_version = true', "protocol_version=True; allowed for protocol = 'original'"),
+    ('protocol = "paper"\nprotocol_version = 2', "[experiment] protocol_version=2; allowed for protocol = 'paper': [1]"),
+    ("protocol_version = 2", "[experiment] protocol_version=2 without a protocol; allowed: with protocol"),
+    ('protocol = "original"\nprotocol_version = 2\n[environment]\nzone_depth = 8',
+     "[environment] zone_depth = 8 contradicts protocol = 'original' (version 2); allowed: 4.0"),
+])
+def test_a_bad_protocol_version_names_the_file_and_key(tmp_path, capsys, body, needle):
+    path = tmp_path / "bad.toml"
+    path.write_text(f"[experiment]\n{body}\n")
+    assert evolve_main([str(path), "--out", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and str(path) in err and needle in err, err
+    assert not (tmp_path / "run").exists()
+
+
 # ---------------------------------------------------------------------------- one layout per run
 def test_one_layout_for_every_trial_and_generation():
     once = [trial_seed(7, 0, 0)]
@@ -149,21 +223,27 @@ def test_one_layout_for_every_trial_and_generation():
     np.testing.assert_array_equal(*layouts)
 
 
-def test_a_genome_meets_the_same_episode_in_every_generation(tmp_path, monkeypatch):
-    """Every evaluation of a per_run experiment runs one episode, on the run's one seed."""
+@pytest.mark.parametrize("version, runs", [
+    (2, [trial_seed(5, 0, 0)]),                             # fixed order: the 3 trials are one episode, run once
+    (3, [trial_seed(5, 0, t) for t in range(3)]),           # shuffled: 3 schedules of the one layout
+])
+def test_a_genome_meets_the_same_episodes_in_every_generation(tmp_path, monkeypatch, version, runs):
+    """Every evaluation of a per_run experiment runs the same episodes, those of generation 0:
+    once under version 2's fixed order, once per trial under version 3's shuffled schedule."""
     seen = []
     real = backends.evaluate
 
     def spy(*args, **kwargs):
         ev = real(*args, **kwargs)
         seen.append((kwargs["generation"], episode_seeds(kwargs["seed"], kwargs["generation"], kwargs["trials"],
-                                                         kwargs["layout"]), len(ev.trial_ft), ev.steps))
+                                                         kwargs["layout"], args[2]), len(ev.trial_ft), ev.steps))
         return ev
 
     monkeypatch.setattr(backends, "evaluate", spy)
-    evolve(experiment(tmp_path, generations=2, population=6), tmp_path / "run")
+    body = f'protocol = "original"\nprotocol_version = {version}'
+    evolve(experiment(tmp_path, generations=2, population=6, body=body), tmp_path / "run")
     assert {g for g, *_ in seen} == {0, 1}
-    assert all(seeds == [trial_seed(5, 0, 0)] and n == 1 and 0 < steps <= 80 for _, seeds, n, steps in seen)
+    assert all(seeds == runs and n == len(runs) and 0 < steps <= 80 * len(runs) for _, seeds, n, steps in seen)
 
 
 # ---------------------------------------------------------------------------- the ratchet
@@ -710,11 +790,11 @@ def test_a_one_layout_run_says_how_its_trials_are_run():
 
     from evolution.run.trainer import protocol_notes
 
-    exp = load_experiment(*resolve_preset("S1-original"))
-    shuffled = {**exp.environment, "drive_model": "force", "robot_drive_force": 1.0, "schedule": "shuffled"}
+    path, overrides = resolve_preset("S1-original")
+    exp = load_experiment(path, overrides)                                   # the newest bundle: shuffled
+    fixed = load_experiment(path, {**overrides, "protocol_version": 2})      # the velocity drive, fixed order
     lines = {name: next(n for n in protocol_notes(e) if "one layout" in n) for name, e in (
-        ("fixed", exp), ("shuffled", replace(exp, environment=shuffled)),
-        ("one", replace(exp, environment=shuffled, trials=1)))}
+        ("fixed", fixed), ("shuffled", exp), ("one", replace(exp, trials=1)))}
     assert "would be the same episode" in lines["fixed"] and "runs it once" in lines["fixed"]
     assert "its 5 trials share it and differ by their shuffled schedules" in lines["shuffled"]
     assert "one trial on it with one shuffled schedule" in lines["one"]

@@ -16,6 +16,8 @@ Layout (every key optional except where noted; defaults are the paper's, docs/mo
                                  # ("adaptive" | "original" | "fixed", evolution.reproduction.species)
     neat_config = "hyperneat_m.neat.cfg"   # neat-python config (see "neat_config" below)
     protocol = "original"        # a named bundle of the options below (evolution.run.protocol)
+    protocol_version = 3         # optional: which version of the bundle (default: the newest;
+                                 # experiment.json records it, evolution.run.protocol)
     layout = "per_trial"         # "per_trial": fresh layouts from (seed, generation, trial);
                                  # "per_run": one layout for the whole run (the original code)
     elitism = "species"          # "species": the [NEATReproduction] elites, re-evaluated;
@@ -55,7 +57,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from evolution.run.protocol import PROTOCOLS, apply_protocol
+from evolution.run.protocol import PROTOCOLS, apply_protocol, newest_version, saved_version, versions
 from gathering_env.config import WorldConfig
 from gathering_env.sensors import COMPLEXITY_FORMULAS
 from gathering_env.world import GatheringWorld
@@ -217,6 +219,7 @@ class Experiment:
     convergence_stop: bool = True
     speciation: str | None = None  # None: the neat config's [GatheringSpeciesSet] species_mode
     protocol: str | None = None
+    protocol_version: int | None = None  # with a protocol: the bundle's version (None: no protocol)
     layout: str = "per_trial"
     elitism: str = "species"
     complexity: str = "paper"
@@ -308,12 +311,24 @@ def experiment_from_run(saved: dict[str, Any], source: str, overrides: dict[str,
     """
     if not isinstance(saved, dict):
         raise ExperimentError(f"{source}: the saved experiment is not a JSON object")
+    saved = with_protocol_version(saved)
     section = {k: v for k, v in saved.items() if k in _EXPERIMENT_KEYS and v is not None}  # None: not set
     if neat_config is not None:
         section["neat_config"] = str(Path(neat_config).resolve())
     raw = {"experiment": section, "environment": saved.get("environment"), "substrate": saved.get("substrate", {})}
     # a resumed run takes its neat config from the checkpoint: the file need not exist any more
     return _validate(raw, source, CONFIG_DIR, overrides, need_neat_config=False)
+
+
+def with_protocol_version(saved: dict[str, Any]) -> dict[str, Any]:
+    """A saved experiment (``Experiment.to_dict()`` form) with its ``protocol_version``: one saved
+    before protocols had versions names a protocol but no version, and gets the version whose
+    keys it holds (``evolution.run.protocol.saved_version``). Anything else is returned as is."""
+    if not isinstance(saved, dict) or saved.get("protocol") not in PROTOCOLS or saved.get("protocol_version") is not None:
+        return saved
+    sections = {"experiment": saved, "environment": saved.get("environment") or {},
+                "substrate": saved.get("substrate") or {}}
+    return {**saved, "protocol_version": saved_version(saved["protocol"], sections)}
 
 
 def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str, Any] | None,
@@ -344,12 +359,21 @@ def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str,
         raise ExperimentError(f"{source}: unknown key(s) {unknown} in [experiment]; allowed: {sorted(_EXPERIMENT_KEYS)}")
     if exp_section.get("protocol", "") is None:
         del exp_section["protocol"]  # a saved experiment without a protocol
+    if exp_section.get("protocol_version", "") is None:
+        del exp_section["protocol_version"]
+    if "protocol_version" in exp_section and "protocol" not in exp_section:
+        raise ExperimentError(f"{source}: [experiment] protocol_version={exp_section['protocol_version']!r} without "
+                              "a protocol; allowed: with protocol = 'original' (or no protocol_version key)")
     if "protocol" in exp_section:
-        _check_key(source, "protocol", exp_section["protocol"])  # before its bundle is applied
+        protocol = _check_key(source, "protocol", exp_section["protocol"])  # before its bundle is applied
+        version = exp_section.setdefault("protocol_version", newest_version(protocol))
+        if isinstance(version, bool) or version not in versions(protocol):
+            raise ExperimentError(f"{source}: [experiment] protocol_version={version!r}; allowed for protocol = "
+                                  f"{protocol!r}: {list(versions(protocol))}")
         try:
-            apply_protocol(exp_section["protocol"], {"experiment": exp_section, "environment": env_section,
-                                                     "substrate": sub_section},
-                           source, exp_section.get("method", "hyperneat-m"))
+            apply_protocol(protocol, {"experiment": exp_section, "environment": env_section,
+                                      "substrate": sub_section},
+                           source, exp_section.get("method", "hyperneat-m"), version)
         except ValueError as err:
             raise ExperimentError(str(err)) from None
     values: dict[str, Any] = {"source": source}
@@ -413,6 +437,8 @@ def _check_key(source: str, key: str, value: Any) -> Any:
             allowed = f">= {low}" if high == math.inf else f"in [{low}, {high}]"
             raise ExperimentError(f"{where}={value!r}; allowed: an integer {allowed}")
         return value
+    if key == "protocol_version":
+        return value  # checked against the protocol's versions before its bundle is applied
     if key == "convergence_stop":
         if not isinstance(value, bool):
             raise ExperimentError(f"{where}={value!r} must be true or false")

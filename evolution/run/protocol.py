@@ -11,7 +11,7 @@ key                           paper (default)     original
 ============================  ==================  ================================================
 ``[experiment] layout``       ``"per_trial"``     ``"per_run"``: one layout for every trial of
                                                   every genome of every generation (the run's
-                                                  seed); the trials are then one episode, run once
+                                                  seed); the trials differ by their schedules
 ``[experiment] elitism``      ``"species"``       ``"ratchet"``: the best-ever genome is
                                                   carried over, unchanged and never re-scored
                                                   (with Encog's selection its species elites too)
@@ -29,12 +29,11 @@ key                           paper (default)     original
 ground_friction``                                 whatever the robots needed (docs/fidelity.md)
 ``[environment] robot_,       0, 0, 0             1, 0.4, 1 (Box2D's: a contact takes the larger)
 block_, wall_restitution``
-``[environment]               1.0, 0.5            3.63, 0.637: the original robot's net push at a
-robot_drive_force,                                standstill (5 from the wheels less its own
-robot_max_speed``                                 kinetic friction 1.37) and its top speed
-                                                  heading +y (measured on its own classes)
-``[environment]               0                   0.28: weaker wheel commands do nothing (the
-drive_dead_band``                                 original robot's own ground friction)
+``[environment] drive_model,  ``"velocity"``, 0   ``"force"``, 0.1: the original robot (wheel
+damping``                                         forces, traction impulse, its own ground
+                                                  friction; ``gathering_env.drive``)
+``[environment] schedule``    ``"fixed"``         ``"shuffled"``: MASON's order, robots and the
+                                                  physics step shuffled every step
 ``[substrate] decode_window`` 1                   0.2 (middle 20 % of range, FOV, orientation)
 ``[substrate] bias_threshold`` false              true (biases thresholded like link weights)
 ============================  ==================  ================================================
@@ -42,52 +41,109 @@ drive_dead_band``                                 original robot's own ground fr
 (The time bonus 20, the 5 trials of 10 000 steps, the sensor-type bands' order and the weld that
 seats the robot are the paper's and the 2018 code's alike, so they are not in the bundle.)
 
-``protocol = "paper"`` names the defaults. A file that names a protocol and sets one of its
-keys to another value is refused (``ExperimentError`` naming the file and key); without a
-``protocol`` key every option is free.
+**Versions.** A bundle that is found to differ from the code it names is corrected in a new
+version, never in place, so that every run made under an earlier one still resumes and rebuilds
+to the same numbers. ``protocol_version`` in ``[experiment]`` picks one (default: the newest);
+``experiment.json`` records the version a run used. A saved experiment from before versions
+(one that names a protocol but no version) holds every key its bundle set, so its version is the
+newest one whose keys it holds with the same values (``saved_version``). The original's:
+
+1. (2026-11) the method, zone, pickup box, IR curve and substrate keys, in this simulator's
+   default physics (the velocity drive at its defaults, a fixed order).
+2. (2026-11) adds the original's contacts (mass ground friction, restitutions) and its robot as
+   the velocity drive models it: net push at a standstill 3.63, top speed 0.637, dead band 0.28
+   (``robot_drive_force``, ``robot_max_speed``, ``drive_dead_band``). With a fixed order the
+   simulator is deterministic, so each genome ran its one layout once.
+3. (2026-12, the newest) the original robot itself (``drive_model = "force"``, ``damping = 0.1``)
+   in place of version 2's velocity-drive keys, and its MASON schedule (``schedule =
+   "shuffled"``): with these the scripted pushing scenes match the original's own classes, and
+   the run's trials share its layout and differ by schedule, as the original's five did.
+
+``protocol = "paper"`` names the defaults (one version). A file that names a protocol and sets
+one of its keys to another value is refused (``ExperimentError`` naming the file and key);
+without a ``protocol`` key every option is free.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-#: Protocol name -> {section: {key: value}}; the "paper" values are the defaults of the
-#: dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``).
-ORIGINAL: dict[str, dict[str, Any]] = {
-    "experiment": {"layout": "per_run", "elitism": "ratchet", "complexity": "original", "speciation": "original"},
-    "environment": {"zone_depth": 4.0, "pickup_box": "centre", "pickup_box_width": 0.2, "pickup_box_depth": 0.1,
-                    "ir_response": "gamma", "ground_friction": "mass", "robot_restitution": 1.0,
-                    "block_restitution": 0.4, "wall_restitution": 1.0, "robot_drive_force": 3.63,
-                    "robot_max_speed": 0.637, "drive_dead_band": 0.28},
-    "substrate": {"decode_window": 0.2, "bias_threshold": True},
-}
+_METHOD = {"layout": "per_run", "elitism": "ratchet", "complexity": "original", "speciation": "original"}
+_SENSING = {"zone_depth": 4.0, "pickup_box": "centre", "pickup_box_width": 0.2, "pickup_box_depth": 0.1,
+            "ir_response": "gamma"}
+_CONTACTS = {"ground_friction": "mass", "robot_restitution": 1.0, "block_restitution": 0.4, "wall_restitution": 1.0}
+_SUBSTRATE = {"decode_window": 0.2, "bias_threshold": True}
 
-#: The world keys of the bundle that are physics (friction, restitution, drive), for scenes
-#: that compare the original's pushing with this simulator's (examples/physics_scenes.py).
-ORIGINAL_PHYSICS = ("ground_friction", "robot_restitution", "block_restitution", "wall_restitution",
-                    "robot_drive_force", "robot_max_speed", "drive_dead_band")
+#: The original's robot as the velocity drive models it (version 1): its net push at a
+#: standstill, top speed heading +y and dead band, measured on its own classes.
+ORIGINAL_VELOCITY_DRIVE = {"robot_drive_force": 3.63, "robot_max_speed": 0.637, "drive_dead_band": 0.28}
 
-#: The original's robot as ``drive_model = "force"`` models it (not part of the bundle yet: the
-#: S1-original evidence was run with the velocity drive's keys above). It replaces the
-#: velocity drive's three keys: ``robot_drive_force``, ``robot_max_speed``, ``drive_dead_band``.
+#: The original's robot itself (``gathering_env.drive``, ``drive_model = "force"``).
 ORIGINAL_FORCE_DRIVE = {"drive_model": "force", "damping": 0.1}
 
-#: The original's MASON schedule on top of the force drive (not part of the bundle either):
-#: robots and the physics step shuffled every step (``gathering_env.drive.shuffled_times``).
+#: The original's MASON schedule, on top of the force drive (``gathering_env.drive.shuffled_times``).
 ORIGINAL_SCHEDULE = {"schedule": "shuffled"}
 
+#: Protocol name -> version -> {section: {key: value}}; the "paper" values are the defaults of
+#: the dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``), filled in
+#: by ``protocol_values``.
+BUNDLES: dict[str, dict[int, dict[str, dict[str, Any]]]] = {
+    "original": {
+        1: {"experiment": _METHOD, "environment": _SENSING, "substrate": _SUBSTRATE},
+        2: {"experiment": _METHOD, "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_VELOCITY_DRIVE},
+            "substrate": _SUBSTRATE},
+        3: {"experiment": _METHOD, "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE,
+                                                   **ORIGINAL_SCHEDULE},
+            "substrate": _SUBSTRATE},
+    },
+    "paper": {1: {}},
+}
+
 PROTOCOLS = ("paper", "original")
+
+#: The original protocol's newest bundle (what ``protocol = "original"`` sets).
+ORIGINAL = BUNDLES["original"][max(BUNDLES["original"])]
+
+#: The world keys of the bundles that are physics (friction, restitution, drive), for scenes
+#: that compare the original's pushing with this simulator's (examples/physics_scenes.py).
+ORIGINAL_PHYSICS = (*_CONTACTS, *ORIGINAL_VELOCITY_DRIVE)
 
 #: One line per protocol, for ``gathering-evolve --list``.
 DESCRIPTIONS = {
     "paper": "the paper's text (the defaults)",
     "original": "the 2018 Java code that produced the published figures: one layout per run, ratchet on the best "
                 "genome, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its eq. 2, its "
-                "physics (mass friction, bouncing contacts, its robot's push, speed and dead band)",
+                "physics (mass friction, bouncing contacts) and its robot on its shuffled schedule",
 }
 
 
+def versions(name: str) -> tuple[int, ...]:
+    """The versions of a protocol, oldest first (raises ``ValueError`` for an unknown name)."""
+    if name not in PROTOCOLS:
+        raise ValueError(f"protocol={name!r}; allowed: {list(PROTOCOLS)}")
+    return tuple(sorted(BUNDLES[name]))
+
+
+def newest_version(name: str) -> int:
+    """The version ``protocol = name`` means when no ``protocol_version`` is given."""
+    return versions(name)[-1]
+
+
+def saved_version(name: str, sections: dict[str, dict[str, Any]]) -> int:
+    """The version of ``name`` that a saved experiment from before versions was run under: the
+    newest whose every key ``sections`` holds with the bundle's value (each version of a bundle
+    sets keys or values the one before did not, and a run saved every key its bundle set)."""
+    for version in reversed(versions(name)):
+        bundle = protocol_values(name, version)
+        if all(key in sections.get(section, {}) and _same(sections[section][key], value)
+               for section, keys in bundle.items() for key, value in keys.items() if value is not None
+               if section != "substrate" or sections.get("substrate")):
+            return version
+    return versions(name)[0]
+
+
 def _paper_values() -> dict[str, dict[str, Any]]:
+    """The defaults of every key any version of any bundle sets."""
     from dataclasses import fields
 
     from evolution.encodings.substrate import Substrate
@@ -96,17 +152,21 @@ def _paper_values() -> dict[str, dict[str, Any]]:
 
     owners = {"experiment": Experiment, "environment": WorldConfig, "substrate": Substrate}
     values: dict[str, dict[str, Any]] = {}
-    for section, keys in ORIGINAL.items():
-        defaults = {f.name: f.default for f in fields(owners[section])}
-        values[section] = {key: defaults[key] for key in keys}
+    for section, owner in owners.items():
+        keys = [key for bundles in BUNDLES.values() for bundle in bundles.values() for key in bundle.get(section, {})]
+        defaults = {f.name: f.default for f in fields(owner)}
+        values[section] = {key: defaults[key] for key in dict.fromkeys(keys)}
     return values
 
 
-def protocol_values(name: str) -> dict[str, dict[str, Any]]:
-    """{section: {key: value}} of a protocol (raises ``ValueError`` for an unknown name)."""
-    if name not in PROTOCOLS:
-        raise ValueError(f"protocol={name!r}; allowed: {list(PROTOCOLS)}")
-    values = ORIGINAL if name == "original" else _paper_values()
+def protocol_values(name: str, version: int | None = None) -> dict[str, dict[str, Any]]:
+    """{section: {key: value}} of a protocol's version (default: the newest); raises
+    ``ValueError`` for an unknown name or version."""
+    known = versions(name)
+    version = known[-1] if version is None else version
+    if version not in known:
+        raise ValueError(f"protocol_version={version!r} for protocol={name!r}; allowed: {list(known)}")
+    values = _paper_values() if name == "paper" else BUNDLES[name][version]
     return {section: dict(keys) for section, keys in values.items()}
 
 
@@ -119,11 +179,13 @@ def _same(a: Any, b: Any) -> bool:
 
 
 def apply_protocol(name: str, sections: dict[str, dict[str, Any]], source: str,
-                   method: str = "hyperneat-m") -> None:
+                   method: str = "hyperneat-m", version: int | None = None) -> None:
     """Fill ``sections`` (experiment / environment / substrate, changed in place) with the
-    protocol's values; a key already set to another value raises ``ValueError`` naming
-    ``source``, the section and the key. Substrate keys only apply to HyperNEAT-M."""
-    for section, keys in protocol_values(name).items():
+    values of the protocol's ``version`` (default: the newest); a key already set to another
+    value raises ``ValueError`` naming ``source``, the section and the key. Substrate keys only
+    apply to HyperNEAT-M."""
+    label = repr(name) if version in (None, newest_version(name)) else f"{name!r} (version {version})"
+    for section, keys in protocol_values(name, version).items():
         if section == "substrate" and method != "hyperneat-m":
             continue
         target = sections[section]
@@ -131,12 +193,14 @@ def apply_protocol(name: str, sections: dict[str, dict[str, Any]], source: str,
             if value is None:  # the paper's "speciation": whatever the neat config says
                 if target.get(key) is not None:
                     raise ValueError(f"{source}: [{section}] {key} = {target[key]!r} contradicts protocol = "
-                                     f"{name!r}; allowed: no {key} key (the neat config's own)")
+                                     f"{label}; allowed: no {key} key (the neat config's own)")
                 continue
             if key in target and not _same(target[key], value):
-                raise ValueError(f"{source}: [{section}] {key} = {target[key]!r} contradicts protocol = {name!r}; "
+                raise ValueError(f"{source}: [{section}] {key} = {target[key]!r} contradicts protocol = {label}; "
                                  f"allowed: {value!r} (or no protocol key, to set it on its own)")
             target[key] = list(value) if isinstance(value, list) else value
 
 
-__all__ = ["DESCRIPTIONS", "ORIGINAL", "ORIGINAL_FORCE_DRIVE", "ORIGINAL_PHYSICS", "ORIGINAL_SCHEDULE", "PROTOCOLS", "apply_protocol", "protocol_values"]
+__all__ = ["BUNDLES", "DESCRIPTIONS", "ORIGINAL", "ORIGINAL_FORCE_DRIVE", "ORIGINAL_PHYSICS", "ORIGINAL_SCHEDULE",
+           "ORIGINAL_VELOCITY_DRIVE", "PROTOCOLS", "apply_protocol", "newest_version", "protocol_values", "saved_version",
+           "versions"]

@@ -75,8 +75,10 @@ def load_record(source: Path, experiment: dict[str, Any]) -> list[dict[str, Any]
     """The recorded generations of ``source`` (a run or evidence folder, or its ``stats.jsonl``)
     to rebuild a run of ``experiment`` (``Experiment.to_dict()``) from; ``RebuildError`` naming
     the file if they cannot be."""
+    from evolution.run.experiment import with_protocol_version
+
     stats_path, exp_path = _record_paths(source)
-    recorded = _read_experiment(exp_path)
+    recorded = with_protocol_version(_read_experiment(exp_path))  # a record from before protocol versions
     for key in sorted(set(recorded) | set(experiment)):
         if key not in NOT_IDENTITY and recorded.get(key) != experiment.get(key):
             raise RebuildError(f"{exp_path}: {key!r} is {recorded.get(key)!r}, the new run's is {experiment.get(key)!r}; "

@@ -61,7 +61,7 @@ def protocol_notes(exp: Experiment) -> list[str]:
     """What a run does differently from the paper's defaults, one line each (printed at its start)."""
     notes = []
     if exp.protocol is not None:
-        notes.append(f"{exp.name}: protocol {exp.protocol!r}")
+        notes.append(f"{exp.name}: protocol {exp.protocol!r}, version {exp.protocol_version} (evolution.run.protocol)")
     if exp.layout == "per_run" and varied_episodes(exp.environment) and exp.trials == 1:
         notes.append(f"{exp.name}: one layout for the whole run (layout = per_run), one trial on it with one "
                      "shuffled schedule (schedule = shuffled), the same for every genome")
