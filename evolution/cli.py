@@ -265,7 +265,7 @@ def replay_main(argv: list[str] | None = None) -> int:
     print(f"{label} in environment {env_config.get('environment', 2)}: ft = {info['task_performance']:.2f}, gathered "
           f"{info['gathered_value']:.0f}/{info['total_value']:.0f} in {info['steps']} steps")
     if not is_policy_name(args.team):
-        print(unseen_note(team, env_config, args.seed))
+        print(unseen_note(team, env_config, args.seed, info["task_performance"]))
     print(f"wrote {path} ({frames} frames)")
     for picture in (args.png, args.sensors_png):
         if picture is not None:

@@ -110,7 +110,7 @@ def replay(team: Champion | Policy, env_config: dict[str, Any], seed: int, out: 
     return info, Path(out), video.frames
 
 
-def unseen_note(champion: Champion, env_config: dict[str, Any], seed: int) -> str:
+def unseen_note(champion: Champion, env_config: dict[str, Any], seed: int, ft: float | None = None) -> str:
     """One line saying how the replayed episode relates to the champion's training score.
 
     A champion's ``task`` objective is its mean ft over the trial episodes of training, drawn
@@ -123,9 +123,14 @@ def unseen_note(champion: Champion, env_config: dict[str, Any], seed: int) -> st
                if env_config.get(key) != champion.environment.get(key)]
     own = champion.trial_seeds
     if seed in own and not changed:
-        if len(own) == 1:
+        if len(own) == 1 and (ft is None or round(ft, 2) == round(trained, 2)):
             return (f"its training episode (seed {seed}, the run's one layout): the simulation is deterministic, "
                     f"so ft equals the training ft {trained:.2f}")
+        if len(own) == 1:
+            return (f"its training episode (seed {seed}, the run's one layout), but ft {ft:.2f} is not the training "
+                    f"ft {trained:.2f}: the run computed other floating-point results (a run from before 2026-12, "
+                    "whose team controllers used processor-dependent BLAS and SIMD code, or other code; "
+                    "docs/guarantees.md, 'The same numbers on every machine')")
         return (f"one of its {len(own)} training episodes (seed {seed}): ft is that trial's score; the training "
                 f"ft {trained:.2f} is the mean over all {len(own)}")
     world = f" in a changed world ({', '.join(changed)})" if changed else ""

@@ -115,3 +115,75 @@ def test_wander_team_follows_its_documented_rule():
         directions.add(float(wheels[0, 0]))
     assert directions == {1.0, -1.0}
     assert DRIFT_PERIOD == 50
+
+
+# ---------------------------------------------------------------------------- the same on every machine
+def python_layer(z, layer):
+    """Plain-Python reference: every sum in column order, every activation by the one scalar
+    formula (``activate.py_func``) on Python floats: IEEE operations and C-library calls only."""
+    from evolution.encodings.controller import ACTIVATIONS, activate
+
+    out = np.empty((z.shape[0], len(layer.targets)))
+    for i in range(z.shape[0]):
+        for node, name in enumerate(layer.activation):
+            total = 0.0
+            for k in range(layer.weights.shape[1]):
+                total += float(z[i, k]) * float(layer.weights[node, k])
+            out[i, node] = activate.py_func(ACTIVATIONS[name], float(layer.bias[node]) + float(layer.response[node]) * total)
+    return out
+
+
+def random_layer(rng, activations, width=11):
+    from evolution.encodings.controller import Layer
+
+    n = len(activations)
+    return Layer(targets=np.arange(width, width + n), weights=rng.normal(0.0, 3.0, (n, width)),
+                 bias=rng.normal(0.0, 2.0, n), response=rng.uniform(0.5, 5.0, n), activation=list(activations))
+
+
+def test_every_activation_is_bit_for_bit_the_plain_python_reference():
+    from evolution.encodings.controller import ACTIVATION_NAMES
+
+    rng = np.random.default_rng(7)
+    layer = random_layer(rng, ACTIVATION_NAMES)
+    z = rng.normal(0.0, 1.0, (64, 11))
+    z[:4] = [[0.0] * 11, [1e-300] * 11, [30.0] * 11, [-30.0] * 11]   # zero, tiny, and clipping values
+    np.testing.assert_array_equal(layer.apply(z), python_layer(z, layer))
+
+
+def test_activations_agree_with_neat_pythons_own():
+    from neat.activations import ActivationFunctionSet
+
+    from evolution.encodings.controller import ACTIVATION_NAMES, ACTIVATIONS, activate
+
+    theirs = ActivationFunctionSet()
+    for name in ACTIVATION_NAMES:
+        if name == "steep_sigmoid":
+            continue
+        for z in (-40.0, -2.0, -0.3, 0.0, 0.2, 1.7, 40.0):
+            assert activate(ACTIVATIONS[name], z) == pytest.approx(theirs.get(name)(z), rel=1e-12, abs=1e-12), name
+
+
+SUBPROCESS = """
+import sys, numpy as np
+from evolution.encodings.controller import TeamController
+rng = np.random.default_rng(3)
+controller = TeamController.single_layer(rng.normal(0.0, 3.0, (2, 10)), rng.normal(0.0, 2.0, 2))
+sys.stdout.write(controller.act(rng.uniform(0.0, 1.0, (100, 10))).tobytes().hex())
+"""
+
+
+def test_commands_do_not_depend_on_the_blas_kernel_or_numpys_simd():
+    """The property the compiled layer exists for: BLAS kernels with and without fused
+    multiply-adds, and numpy with and without its AVX-512 code, give the same bits."""
+    import os
+    import subprocess
+    import sys
+
+    outputs = set()
+    for blas, simd in (("Haswell", ""), ("Sandybridge", ""), ("Haswell", "X86_V4 AVX512_ICL")):
+        env = {**os.environ, "OPENBLAS_CORETYPE": blas, "NPY_DISABLE_CPU_FEATURES": simd}
+        env.pop("OPENBLAS_L2_SIZE", None)
+        run = subprocess.run([sys.executable, "-c", SUBPROCESS], env=env, capture_output=True, text=True, check=True)
+        outputs.add(run.stdout)
+    assert len(outputs) == 1

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import imageio.v2 as imageio
 import numpy as np
@@ -122,3 +123,26 @@ def test_a_per_run_champion_replayed_on_its_layout_scores_its_training_ft(tmp_pa
     assert lines[1].startswith(f"its training episode (seed {layout}, the run's one layout)")
     assert replay_main([str(tmp_path / "run" / "champion.json"), "--out", str(tmp_path / "new.gif")]) == 0
     assert f"(its training layout is --seed {layout})" in capsys.readouterr().out
+
+
+def test_a_replay_that_does_not_reproduce_its_training_ft_says_so(tmp_path, capsys):
+    """The converged S1 champion of docs/evidence/original-S1-shuffled was scored 110.44 on a
+    machine whose team controllers took its BLAS kernel and numpy's SIMD code; replayed with
+    the processor-independent controller its training episode scores 105.73 (the same on every
+    machine), and the note says that it is not the training ft instead of claiming it is."""
+    from evolution.replay import unseen_note
+    from evolution.run.champion import load_champion
+
+    path = Path(__file__).resolve().parents[1] / "docs" / "evidence" / "original-S1-shuffled" / "champion.json"
+    champion = load_champion(path)
+    seed = champion.trial_seeds[0]
+    env_config = dict(champion.environment)
+    assert unseen_note(champion, env_config, seed, 110.436).endswith("so ft equals the training ft 110.44")
+    assert "but ft 90.00 is not the training ft 110.44" in unseen_note(champion, env_config, seed, 90.0)
+    capsys.readouterr()
+    assert replay_main([str(path), "--seed", str(seed), "--frame-every", "100000",
+                        "--out", str(tmp_path / "own.gif")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert "ft = 105.73, gathered 20/20 in 7135 steps" in lines[0]
+    assert lines[1].startswith(f"its training episode (seed {seed}, the run's one layout), but ft 105.73 is not "
+                               "the training ft 110.44")
