@@ -43,11 +43,9 @@ ACTIVATION_NAMES = ("steep_sigmoid", "sigmoid", "tanh", "sin", "gauss", "relu", 
 ACTIVATIONS = {name: code for code, name in enumerate(ACTIVATION_NAMES)}
 
 
+@njit(cache=True)
 def _clip(x: float, low: float, high: float) -> float:
     return low if x < low else high if x > high else x
-
-
-_clip_c = njit(cache=True)(_clip)
 
 
 @njit(cache=True)
@@ -55,22 +53,22 @@ def activate(code: int, z: float) -> float:  # noqa: C901 - one branch per funct
     """Activation ``ACTIVATION_NAMES[code]`` of one value (scalar IEEE operations and C-library
     calls only, so the same on every processor)."""
     if code == 0:
-        return 1.0 / (1.0 + math.exp(-4.924273 * _clip_c(z - 2.4621365, -30.0, 30.0)))
+        return 1.0 / (1.0 + math.exp(-4.924273 * _clip(z - 2.4621365, -30.0, 30.0)))
     if code == 1:
-        return 1.0 / (1.0 + math.exp(-_clip_c(5.0 * z, -60.0, 60.0)))
+        return 1.0 / (1.0 + math.exp(-_clip(5.0 * z, -60.0, 60.0)))
     if code == 2:
-        return math.tanh(_clip_c(2.5 * z, -60.0, 60.0))
+        return math.tanh(_clip(2.5 * z, -60.0, 60.0))
     if code == 3:
-        return math.sin(_clip_c(5.0 * z, -60.0, 60.0))
+        return math.sin(_clip(5.0 * z, -60.0, 60.0))
     if code == 4:
-        c = _clip_c(z, -3.4, 3.4)
+        c = _clip(z, -3.4, 3.4)
         return math.exp(-5.0 * (c * c))
     if code == 5:
         return z if z > 0.0 else 0.0
     if code == 6:
         return z
     if code == 7:
-        return _clip_c(z, -1.0, 1.0)
+        return _clip(z, -1.0, 1.0)
     if code == 8:
         return abs(z)
     if code == 9:
@@ -80,9 +78,9 @@ def activate(code: int, z: float) -> float:  # noqa: C901 - one branch per funct
     if code == 11:
         return z * z * z
     if code == 12:
-        return 0.2 * math.log1p(math.exp(_clip_c(5.0 * z, -60.0, 60.0)))
+        return 0.2 * math.log1p(math.exp(_clip(5.0 * z, -60.0, 60.0)))
     if code == 13:
-        return math.exp(_clip_c(z, -60.0, 60.0))
+        return math.exp(_clip(z, -60.0, 60.0))
     if code == 14:
         return z if z > 0.0 else math.expm1(z)
     return z if z > 0.0 else 0.005 * z
