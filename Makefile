@@ -2,7 +2,7 @@
 # make test           : ... install everything the tests import (test extras + RL, MARL, Ray, video), run the fast tests
 # make test-slow      : ... the same install, run the slow tests (CI runs make test, then make test-slow)
 # (With only ".[dev]" installed the RL, Ray and MP4 tests skip; everything else runs.)
-# make bench          : print the environment and generation benchmarks
+# make bench          : print the environment, controller and generation benchmarks
 # make bench-learning : the learning benchmark (S1 and M1 at a mid budget, held-out comparison)
 # make docs-images    : regenerate every figure of docs/ (examples/docs_images.py)
 # make mutation       : mutation testing (mutmut) of the study-critical modules; survivors -> mutation-survivors.txt
@@ -44,6 +44,7 @@ demo: $(CORE)
 
 bench: $(CORE)
 	$(PY) benchmarks/bench_env.py
+	$(PY) benchmarks/bench_controller.py
 	SDL_VIDEODRIVER=dummy $(PY) benchmarks/bench_generation.py
 
 # Does evolution learn? S1 and M1 at a mid budget (about an hour on 2 idle cores), then the

@@ -334,6 +334,7 @@ def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_pa
     assert len(whole) == 4 and part == whole
     saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
     assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0
+    assert saved["protocol_version"] == 3 and saved["environment"]["schedule"] == "shuffled"
     shutil.rmtree(tmp_path / "part")
 
 
@@ -796,6 +797,7 @@ def test_a_one_layout_run_says_how_its_trials_are_run():
     lines = {name: next(n for n in protocol_notes(e) if "one layout" in n) for name, e in (
         ("fixed", fixed), ("shuffled", exp), ("one", replace(exp, trials=1)))}
     assert "would be the same episode" in lines["fixed"] and "runs it once" in lines["fixed"]
+    assert "S1-original: protocol 'original', version 2 (evolution.run.protocol)" in protocol_notes(fixed)
     assert "its 5 trials share it and differ by their shuffled schedules" in lines["shuffled"]
     assert "one trial on it with one shuffled schedule" in lines["one"]
 
