@@ -810,3 +810,13 @@ def test_a_one_layout_run_refuses_a_layout_seed_of_its_own(tmp_path):
     path = experiment(tmp_path, name="fresh", body="")
     path.write_text(path.read_text() + "layout_seed = 4\n")
     assert load_experiment(path).world_config().layout_seed == 4
+
+
+def test_the_front_box_experiment_differs_from_the_newest_bundle_by_the_box_alone():
+    front = load_experiment(EVIDENCE / "original-S1-front" / "experiment.toml")
+    preset = load_experiment(*resolve_preset("S1-original"))
+    differ = {k for k in set(front.environment) | set(preset.environment)
+              if front.environment.get(k) != preset.environment.get(k)}
+    assert differ == {"pickup_box"} and front.environment["pickup_box"] == "front"
+    assert (front.layout, front.elitism, front.complexity, front.speciation, front.substrate) == (
+        preset.layout, preset.elitism, preset.complexity, preset.speciation, preset.substrate)
