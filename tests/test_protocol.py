@@ -820,3 +820,17 @@ def test_the_front_box_experiment_differs_from_the_newest_bundle_by_the_box_alon
     assert differ == {"pickup_box"} and front.environment["pickup_box"] == "front"
     assert (front.layout, front.elitism, front.complexity, front.speciation, front.substrate) == (
         preset.layout, preset.elitism, preset.complexity, preset.speciation, preset.substrate)
+
+
+def test_a_paper_protocol_run_saved_before_the_bundle_grew_resumes_in_the_same_world(tmp_path):
+    """protocol = "paper" names the defaults of every key of every version, so it gained
+    drive_model, damping and schedule with version 3 of the original; a run saved before holds
+    the keys it had, and its experiment must come back the same (resume compares it)."""
+    exp = load_experiment(experiment(tmp_path, body='protocol = "paper"'))
+    saved = exp.to_dict()
+    for key in ("drive_model", "damping", "schedule"):
+        del saved["environment"][key]
+    del saved["protocol_version"]
+    again = experiment_from_run(saved, "experiment.json")
+    assert again.environment == saved["environment"] and again.world_config() == exp.world_config()
+    assert again.to_dict()["environment"] == saved["environment"]

@@ -317,7 +317,7 @@ def experiment_from_run(saved: dict[str, Any], source: str, overrides: dict[str,
         section["neat_config"] = str(Path(neat_config).resolve())
     raw = {"experiment": section, "environment": saved.get("environment"), "substrate": saved.get("substrate", {})}
     # a resumed run takes its neat config from the checkpoint: the file need not exist any more
-    return _validate(raw, source, CONFIG_DIR, overrides, need_neat_config=False)
+    return _validate(raw, source, CONFIG_DIR, overrides, need_neat_config=False, saved=True)
 
 
 def with_protocol_version(saved: dict[str, Any]) -> dict[str, Any]:
@@ -332,7 +332,7 @@ def with_protocol_version(saved: dict[str, Any]) -> dict[str, Any]:
 
 
 def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str, Any] | None,
-              need_neat_config: bool = True) -> Experiment:
+              need_neat_config: bool = True, saved: bool = False) -> Experiment:
     unknown_sections = sorted(set(raw) - {"experiment", "environment", "substrate"})
     if unknown_sections:
         raise ExperimentError(
@@ -373,7 +373,7 @@ def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str,
         try:
             apply_protocol(protocol, {"experiment": exp_section, "environment": env_section,
                                       "substrate": sub_section},
-                           source, exp_section.get("method", "hyperneat-m"), version)
+                           source, exp_section.get("method", "hyperneat-m"), version, fill=not saved)
         except ValueError as err:
             raise ExperimentError(str(err)) from None
     values: dict[str, Any] = {"source": source}

@@ -74,7 +74,7 @@ _SENSING = {"zone_depth": 4.0, "pickup_box": "centre", "pickup_box_width": 0.2, 
 _CONTACTS = {"ground_friction": "mass", "robot_restitution": 1.0, "block_restitution": 0.4, "wall_restitution": 1.0}
 _SUBSTRATE = {"decode_window": 0.2, "bias_threshold": True}
 
-#: The original's robot as the velocity drive models it (version 1): its net push at a
+#: The original's robot as the velocity drive models it (version 2): its net push at a
 #: standstill, top speed heading +y and dead band, measured on its own classes.
 ORIGINAL_VELOCITY_DRIVE = {"robot_drive_force": 3.63, "robot_max_speed": 0.637, "drive_dead_band": 0.28}
 
@@ -179,11 +179,13 @@ def _same(a: Any, b: Any) -> bool:
 
 
 def apply_protocol(name: str, sections: dict[str, dict[str, Any]], source: str,
-                   method: str = "hyperneat-m", version: int | None = None) -> None:
+                   method: str = "hyperneat-m", version: int | None = None, fill: bool = True) -> None:
     """Fill ``sections`` (experiment / environment / substrate, changed in place) with the
     values of the protocol's ``version`` (default: the newest); a key already set to another
     value raises ``ValueError`` naming ``source``, the section and the key. Substrate keys only
-    apply to HyperNEAT-M."""
+    apply to HyperNEAT-M. ``fill=False`` only checks: a saved run holds every key its bundle set
+    when it ran, and a key the bundle has gained since (``protocol = "paper"`` names the defaults
+    of every key of every version) is left out, which gives the same world."""
     label = repr(name) if version in (None, newest_version(name)) else f"{name!r} (version {version})"
     for section, keys in protocol_values(name, version).items():
         if section == "substrate" and method != "hyperneat-m":
@@ -198,7 +200,8 @@ def apply_protocol(name: str, sections: dict[str, dict[str, Any]], source: str,
             if key in target and not _same(target[key], value):
                 raise ValueError(f"{source}: [{section}] {key} = {target[key]!r} contradicts protocol = {label}; "
                                  f"allowed: {value!r} (or no protocol key, to set it on its own)")
-            target[key] = list(value) if isinstance(value, list) else value
+            if fill:
+                target[key] = list(value) if isinstance(value, list) else value
 
 
 __all__ = ["BUNDLES", "DESCRIPTIONS", "ORIGINAL", "ORIGINAL_FORCE_DRIVE", "ORIGINAL_PHYSICS", "ORIGINAL_SCHEDULE",
