@@ -25,7 +25,7 @@ from evolution.run.experiment import (
     protocol_preset_names,
     resolve_preset,
 )
-from evolution.run.protocol import DESCRIPTIONS, PROTOCOLS
+from evolution.run.protocol import DESCRIPTIONS, PROTOCOLS, newest_version
 
 MAX_WORKERS = max(4, 4 * (os.cpu_count() or 1))
 """Most evaluation processes ``--workers`` may ask for: four per core (each worker holds its own
@@ -37,7 +37,8 @@ def _list_presets() -> int:
     for name in preset_names():
         print(f"{name:22s} {preset_description(name)}")
     for protocol in PROTOCOLS[1:]:
-        print(f"# protocol \"{protocol}\": {DESCRIPTIONS[protocol]}")
+        print(f"# protocol \"{protocol}\" (version {newest_version(protocol)}; protocol_version picks another): "
+              f"{DESCRIPTIONS[protocol]}")
         for name in protocol_preset_names():
             if name.endswith(f"-{protocol}"):
                 print(f"{name:22s} {protocol_preset_description(name)}")
