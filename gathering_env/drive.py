@@ -136,12 +136,34 @@ def wheel_force(command: np.ndarray, vx: np.ndarray) -> np.ndarray:
     return command * WHEEL_FORCE * fade
 
 
+class BlockDraws:
+    """``random(n)`` for a fixed ``n``, served from blocks of ``rows`` draws made at once.
+
+    A numpy ``Generator`` fills an array draw by draw in C order, so row k of a block is exactly
+    what the k-th call ``rng.random(n)`` would have returned: the same schedule, for one call to
+    the generator every ``rows`` steps instead of every step."""
+
+    def __init__(self, rng: np.random.Generator, n: int, rows: int = 1024) -> None:
+        self.rng, self.n, self.rows = rng, int(n), int(rows)
+        self.block = np.empty((0, self.n))
+        self.row = 0
+
+    def random(self, n: int) -> np.ndarray:
+        if n != self.n:
+            raise ValueError(f"n={n}; allowed: {self.n} (the width these draws were made for)")
+        if self.row == self.block.shape[0]:
+            self.block = self.rng.random((self.rows, self.n))
+            self.row = 0
+        self.row += 1
+        return self.block[self.row - 1]
+
+
 def shuffled_times(rng: np.random.Generator, acted_after: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """'shuffled' schedule: how often each robot's drive reaches this physics step.
 
     Args:
-        rng: the episode's schedule generator (one uniform draw per robot and one for the
-            physics step, every step: their order in MASON's shuffle).
+        rng: the episode's schedule generator, or its ``BlockDraws`` (one uniform draw per
+            robot and one for the physics step, every step: their order in MASON's shuffle).
         acted_after: (N,) bool, the robots that acted after the previous physics step.
 
     Returns:

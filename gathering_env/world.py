@@ -35,7 +35,7 @@ import pymunk.batch as pbatch
 
 from .config import WorldConfig
 from .contacts import apply_restitution
-from .drive import control_limits, force_drive, shuffled_times, substep_keep, velocity_drive
+from .drive import BlockDraws, control_limits, force_drive, shuffled_times, substep_keep, velocity_drive
 from .placement import check_placement, lay_out
 
 _VEL = pbatch.BodyFields.VELOCITY | pbatch.BodyFields.ANGULAR_VELOCITY
@@ -162,7 +162,7 @@ class GatheringWorld:
         self._welds: dict[int, tuple[pymunk.Constraint, pymunk.Constraint]] = {}
         # The shuffled schedule's own generator: a child of rng's seed, so it does not depend on
         # the layout's draws (the same with and without layout_seed) and leaves them alone.
-        self._schedule_rng = rng.spawn(1)[0] if cfg.schedule == "shuffled" else None
+        self._schedule_rng = BlockDraws(rng.spawn(1)[0], n + 1) if cfg.schedule == "shuffled" else None
         self._acted_after = np.zeros(n, dtype=bool)
         self.read_state()
 

@@ -209,3 +209,16 @@ def test_the_shuffled_schedule_leaves_the_layout_of_a_seed_alone():
     fixed, shuffled = (GatheringSimulation(WorldConfig.from_kwargs(2, schedule=s, **FORCE)) for s in ("fixed", "shuffled"))
     assert np.array_equal(fixed.reset(seed=11), shuffled.reset(seed=11))
     assert np.array_equal(fixed.world.raw, shuffled.world.raw)
+
+
+def test_block_draws_are_the_generators_own_draws_in_order():
+    """The world draws its schedule in blocks: across block boundaries the rows are exactly the
+    successive ``rng.random(n)`` calls of the same generator."""
+    from gathering_env.drive import BlockDraws
+
+    direct = np.random.default_rng(11)
+    blocks = BlockDraws(np.random.default_rng(11), 4, rows=3)
+    for _ in range(10):                                  # 3 blocks and a part
+        np.testing.assert_array_equal(blocks.random(4), direct.random(4))
+    with pytest.raises(ValueError, match="n=5; allowed: 4"):
+        blocks.random(5)
