@@ -152,6 +152,11 @@ def make_original_s1_shuffled(args: argparse.Namespace) -> None:
     record_curve("original-S1-shuffled", "S1-original, force drive, shuffled schedule")
 
 
+def make_original_s1_five(args: argparse.Namespace) -> None:
+    """S1-original under version 3: five schedules a genome (kept going across sessions)."""
+    record_curve("original-S1-five", "S1-original (version 3), five schedules a genome")
+
+
 LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
 LEARNING_RUN_FILES = ("stats.png", "stats.jsonl", "stats.csv", "experiment.json", "champion.json")
 
@@ -189,6 +194,7 @@ STEPS: dict[str, Step] = {
                                   make_original_s1_continued),
     "original-s1-shuffled": Step(("evidence/original-S1-shuffled/stats.png",), None,
                                  make_original_s1_shuffled),
+    "original-s1-five": Step(("evidence/original-S1-five/stats.png",), None, make_original_s1_five),
     "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
                       "evidence/learning/M1/stats.png"), "learning", make_learning),
 }
