@@ -123,14 +123,20 @@ def unseen_note(champion: Champion, env_config: dict[str, Any], seed: int, ft: f
                if env_config.get(key) != champion.environment.get(key)]
     own = champion.trial_seeds
     if seed in own and not changed:
-        if len(own) == 1 and (ft is None or round(ft, 2) == round(trained, 2)):
-            return (f"its training episode (seed {seed}, the run's one layout): the simulation is deterministic, "
-                    f"so ft equals the training ft {trained:.2f}")
+        trial = own.index(seed)
+        recorded = champion.trial_ft[trial] if champion.trial_ft else trained if len(own) == 1 else None
+        which = (f"its training episode (seed {seed}, the run's one layout)" if len(own) == 1 else
+                 f"training episode {trial + 1} of its {len(own)} (seed {seed})")
+        if ft is not None and recorded is not None and round(ft, 2) != round(recorded, 2):
+            return (f"{which}, but ft {ft:.2f} is not the ft {recorded:.2f} it scored in training: the run "
+                    "computed other floating-point results (a run from before 2026-12, whose team controllers "
+                    "used processor-dependent BLAS and SIMD code, or other code; docs/guarantees.md, 'The same "
+                    "numbers on every machine')")
         if len(own) == 1:
-            return (f"its training episode (seed {seed}, the run's one layout), but ft {ft:.2f} is not the training "
-                    f"ft {trained:.2f}: the run computed other floating-point results (a run from before 2026-12, "
-                    "whose team controllers used processor-dependent BLAS and SIMD code, or other code; "
-                    "docs/guarantees.md, 'The same numbers on every machine')")
+            return f"{which}: the simulation is deterministic, so ft equals the training ft {trained:.2f}"
+        if recorded is not None:
+            return (f"{which}: ft equals the ft it scored in training, {recorded:.2f}; the training ft "
+                    f"{trained:.2f} is the mean over all {len(own)}")
         return (f"one of its {len(own)} training episodes (seed {seed}): ft is that trial's score; the training "
                 f"ft {trained:.2f} is the mean over all {len(own)}")
     world = f" in a changed world ({', '.join(changed)})" if changed else ""

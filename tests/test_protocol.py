@@ -779,7 +779,10 @@ def test_a_shuffled_one_layout_champion_replays_each_training_trial_exactly(tmp_
                             "--out", str(tmp_path / f"t{seed}.gif")]) == 0
         lines = capsys.readouterr().out.splitlines()
         replayed.append(float(lines[0].split("ft = ")[1].split()[0].rstrip(",")))
-        assert lines[1].startswith(f"one of its 2 training episodes (seed {seed})")
+        trial = seeds.index(seed)
+        assert lines[1].startswith(f"training episode {trial + 1} of its 2 (seed {seed}): ft equals the ft it "
+                                   f"scored in training, {champ.trial_ft[trial]:.2f}")
+    assert replayed == pytest.approx(list(champ.trial_ft), abs=0.005)     # each trial, as the champion recorded it
     assert np.mean(replayed) == pytest.approx(champ.objectives["task"], abs=0.01)
     evolve(exp, tmp_path / "part", "--generations", "2")
     evolve(exp, tmp_path / "part", "--resume")

@@ -137,12 +137,26 @@ def test_a_replay_that_does_not_reproduce_its_training_ft_says_so(tmp_path, caps
     champion = load_champion(path)
     seed = champion.trial_seeds[0]
     env_config = dict(champion.environment)
+    assert champion.trial_ft == ()                       # a file from before 2026-12: the training ft stands in
     assert unseen_note(champion, env_config, seed, 110.436).endswith("so ft equals the training ft 110.44")
-    assert "but ft 90.00 is not the training ft 110.44" in unseen_note(champion, env_config, seed, 90.0)
+    assert "but ft 90.00 is not the ft 110.44 it scored in training" in unseen_note(champion, env_config, seed, 90.0)
     capsys.readouterr()
     assert replay_main([str(path), "--seed", str(seed), "--frame-every", "100000",
                         "--out", str(tmp_path / "own.gif")]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert "ft = 105.73, gathered 20/20 in 7135 steps" in lines[0]
     assert lines[1].startswith(f"its training episode (seed {seed}, the run's one layout), but ft 105.73 is not "
-                               "the training ft 110.44")
+                               "the ft 110.44 it scored in training")
+
+
+@pytest.mark.parametrize("value, shown", [([1.0, 2.0], "[1.0, 2.0]"), (["85"], "['85']"), ([True], "[True]")])
+def test_a_champion_with_a_bad_trial_ft_is_refused_naming_the_field(tmp_path, capsys, value, shown):
+    source = Path(__file__).resolve().parents[1] / "docs" / "evidence" / "original-S1-shuffled" / "champion.json"
+    doc = json.loads(source.read_text())
+    doc["trial_ft"] = value                              # one trial seed, so one finite ft is allowed
+    bad = tmp_path / "champion.json"
+    bad.write_text(json.dumps(doc))
+    assert replay_main([str(bad), "--out", str(tmp_path / "x.gif")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (f"error: {bad}: field 'trial_ft' is {shown}; allowed: a finite ft for each of the 1 trial_seeds")
+    assert not (tmp_path / "x.gif").exists()

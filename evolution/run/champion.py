@@ -113,13 +113,17 @@ class Champion:
     genome: dict[str, Any] | None = None
     trial_seeds: tuple[int, ...] = ()
     """The episodes of ``objectives['task']`` (empty: not recorded, e.g. a file of an older run)."""
+    trial_ft: tuple[float, ...] = ()
+    """ft of each of ``trial_seeds``, in order (empty: not recorded, a file from before 2026-12)."""
 
 
 def save_champion(path: Path, *, method: str, experiment: str, generation: int, genome: Any,
                   morphology: Morphology, controller: Any, objectives: dict[str, float],
-                  environment: dict[str, Any], trial_seeds: list[int] | None = None) -> Path:
+                  environment: dict[str, Any], trial_seeds: list[int] | None = None,
+                  trial_ft: list[float] | None = None) -> Path:
     """Write a champion JSON file atomically; returns its path. ``trial_seeds``: the episodes
-    its ``task`` objective is the mean ft over (``evolution.run.evaluate.episode_seeds``)."""
+    its ``task`` objective is the mean ft over (``evolution.run.evaluate.episode_seeds``);
+    ``trial_ft``: the ft of each (so a replay can check each training episode)."""
     doc = {
         "format": FORMAT,
         "version": VERSION,
@@ -135,6 +139,8 @@ def save_champion(path: Path, *, method: str, experiment: str, generation: int, 
     }
     if trial_seeds is not None:
         doc["trial_seeds"] = [int(s) for s in trial_seeds]
+        if trial_ft is not None and len(trial_ft) == len(trial_seeds):
+            doc["trial_ft"] = [float(f) for f in trial_ft]
     path = Path(path)
     atomic_write_bytes(path, (json.dumps(doc, indent=1, allow_nan=False) + "\n").encode())
     return path
@@ -176,6 +182,11 @@ def load_champion(path: str | Path) -> Champion:
                                                for s in seeds):
         raise ChampionError(f"{path}: field 'trial_seeds' is {seeds!r}; allowed: a list of episode seeds "
                             "(integers >= 0)")
+    fts = doc.get("trial_ft", [])
+    if not isinstance(fts, list) or not all(isinstance(f, (int, float)) and not isinstance(f, bool)
+                                            and math.isfinite(f) for f in fts) or len(fts) not in (0, len(seeds)):
+        raise ChampionError(f"{path}: field 'trial_ft' is {fts!r}; allowed: a finite ft for each of the "
+                            f"{len(seeds)} trial_seeds")
     if controller.num_inputs != len(morphology):
         raise ChampionError(f"{path}: field 'controller' reads {controller.num_inputs} inputs but the morphology "
                             f"has {len(morphology)} sensors; allowed: one input per sensor")
@@ -184,6 +195,7 @@ def load_champion(path: str | Path) -> Champion:
         objectives=objectives, environment=dict(doc["environment"]),
         experiment=str(doc.get("experiment", "")), generation=doc.get("generation", -1),
         genome_key=doc.get("genome_key", -1), genome=doc.get("genome"), trial_seeds=tuple(seeds),
+        trial_ft=tuple(float(f) for f in fts),
     )
 
 

@@ -140,7 +140,8 @@ class RunRecorder:
                       objectives={"task": evaluation.task, "morphology": evaluation.morphology,
                                   "controller": evaluation.controller},
                       environment=training_environment(exp.environment, exp.seed, exp.layout),
-                      trial_seeds=episode_seeds(exp.seed, generation, exp.trials, exp.layout, exp.environment))
+                      trial_seeds=episode_seeds(exp.seed, generation, exp.trials, exp.layout, exp.environment),
+                      trial_ft=evaluation.trial_ft)
 
     def write_front(self, population: neat.Population) -> None:
         """Write every genome of the final first front as a JSON champion in ``front/``."""
