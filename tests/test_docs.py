@@ -227,6 +227,36 @@ def test_relative_links_resolve():
     assert not missing, missing
 
 
+def heading_anchors(page: Path) -> set[str]:
+    """The anchors a Markdown renderer makes of a page's headings (lowercase, punctuation but
+    hyphens dropped, spaces to hyphens, a repeated one numbered), code blocks skipped."""
+    found: set[str] = set()
+    counts: dict[str, int] = {}
+    fenced = False
+    for line in page.read_text(encoding="utf-8").splitlines():
+        if line.startswith("```"):
+            fenced = not fenced
+        heading = None if fenced else re.match(r"#{1,6} (.*)", line)
+        if heading:
+            slug = re.sub(r"[^\w\- ]", "", heading.group(1).strip().lower()).replace(" ", "-")
+            found.add(slug if slug not in counts else f"{slug}-{counts[slug]}")
+            counts[slug] = counts.get(slug, 0) + 1
+    return found
+
+
+def test_links_to_a_section_name_one_that_exists():
+    link = re.compile(r"\]\(([^)#\s]*)#([^)\s]+)\)")
+    broken = []
+    for page in PAGES:
+        for target, anchor in link.findall(page.read_text(encoding="utf-8")):
+            destination = page if not target else (page.parent / target).resolve()
+            if re.match(r"[a-z]+:", target) or destination.suffix != ".md" or not destination.exists():
+                continue
+            if anchor not in heading_anchors(destination):
+                broken.append(f"{page.relative_to(ROOT)}: {target}#{anchor}")
+    assert not broken, broken
+
+
 def test_a_failing_block_fails_and_blocks_use_this_checkout(tmp_path, tool_dir):
     page = tmp_path / "page.md"
     page.write_text(
