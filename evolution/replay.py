@@ -131,7 +131,7 @@ def unseen_note(champion: Champion, env_config: dict[str, Any], seed: int, ft: f
             return (f"{which}, but ft {ft:.2f} is not the ft {recorded:.2f} it scored in training: the run "
                     "computed other floating-point results (a run from before 2026-12, whose team controllers "
                     "used processor-dependent BLAS and SIMD code, or other code; docs/guarantees.md, 'The same "
-                    "numbers on every machine')")
+                    "numbers on other machines')")
         if len(own) == 1:
             return f"{which}: the simulation is deterministic, so ft equals the training ft {trained:.2f}"
         if recorded is not None:

@@ -128,8 +128,8 @@ def test_a_per_run_champion_replayed_on_its_layout_scores_its_training_ft(tmp_pa
 def test_a_replay_that_does_not_reproduce_its_training_ft_says_so(tmp_path, capsys):
     """The converged S1 champion of docs/evidence/original-S1-shuffled was scored 110.44 on a
     machine whose team controllers took its BLAS kernel and numpy's SIMD code; replayed with
-    the processor-independent controller its training episode scores 105.73 (the same on every
-    machine), and the note says that it is not the training ft instead of claiming it is."""
+    the compiled controller its training episode scores 105.73 (whatever the BLAS kernel and
+    numpy's SIMD code), and the note says that it is not the training ft instead of claiming it is."""
     from evolution.replay import unseen_note
     from evolution.run.champion import load_champion
 

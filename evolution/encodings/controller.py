@@ -11,10 +11,11 @@ The two output nodes give the left and right wheel: ``wheel = 2 * output - 1``; 
 HyperNEAT-M default output activation ``steep_sigmoid`` = ``1 / (1 + exp(-4.924273 (x -
 2.4621365)))`` the outputs lie in (0, 1), so wheels lie in (-1, 1).
 
-**The same numbers on every machine.** A layer runs as one compiled loop (``_layer``): each
+**The same numbers on other machines.** A layer runs as one compiled loop (``_layer``): each
 node's weighted sum is added up input by input in column order, without fused multiply-adds,
-and the activation calls the C library's ``exp``, ``tanh``, ... on one value at a time. Every
-step of that is one IEEE operation, so the result does not depend on the processor. numpy's
+and the activation calls the C library's ``exp``, ``tanh``, ... on one value at a time. So the
+result depends on neither the BLAS kernel nor numpy's SIMD code (only, like every kernel, on the
+C library's functions: docs/guarantees.md). numpy's
 matrix product would not do: BLAS picks a kernel per processor (with or without FMA), and
 numpy's ``exp`` and ``tanh`` take processor-specific SIMD code (AVX-512 or not); a team's
 commands then differ in the last bit between machines, and over a 10 000-step episode the
@@ -51,7 +52,7 @@ def _clip(x: float, low: float, high: float) -> float:
 @njit(cache=True)
 def activate(code: int, z: float) -> float:  # noqa: C901 - one branch per function
     """Activation ``ACTIVATION_NAMES[code]`` of one value (scalar IEEE operations and C-library
-    calls only, so the same on every processor)."""
+    calls only, so it does not depend on numpy's SIMD code)."""
     if code == 0:
         return 1.0 / (1.0 + math.exp(-4.924273 * _clip(z - 2.4621365, -30.0, 30.0)))
     if code == 1:
