@@ -41,7 +41,8 @@ from evolution.analysis.reevaluate import heldout_seeds  # noqa: E402
 from evolution.compare import run_episode  # noqa: E402
 from evolution.policies import make_policy  # noqa: E402
 from evolution.run.champion import champion_objectives, read_json  # noqa: E402
-from evolution.run.experiment import load_experiment, preset_path  # noqa: E402
+from evolution.run.experiment import load_experiment  # noqa: E402
+from evolution.run.presets import preset_path  # noqa: E402
 from evolution.run.stats import read_stats  # noqa: E402
 from evolution.run.trainer import Trainer  # noqa: E402
 from gathering_env import parallel_env  # noqa: E402

@@ -20,7 +20,8 @@ from pathlib import Path
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
 from evolution.guard import ArgumentParser, command, int_arg  # noqa: E402
-from evolution.run.experiment import load_experiment, resolve_preset  # noqa: E402
+from evolution.run.experiment import load_experiment  # noqa: E402
+from evolution.run.presets import resolve_preset  # noqa: E402
 from evolution.run.stats import read_stats, without_work  # noqa: E402
 from evolution.run.trainer import Trainer  # noqa: E402
 

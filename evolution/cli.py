@@ -12,11 +12,9 @@ import sys
 from pathlib import Path
 
 from evolution.guard import ArgumentParser, UsageError, check_output_file, command, int_arg
-from evolution.run.experiment import (
-    LIMITS,
-    METHODS,
+from evolution.run.experiment import LIMITS, METHODS, load_experiment
+from evolution.run.presets import (
     is_preset_name,
-    load_experiment,
     neat_config_names,
     preset_description,
     preset_names,

@@ -14,11 +14,10 @@ import pytest
 import gathering_env
 from evolution import __version__ as evolution_version
 from evolution.cli import evolve_main
-from evolution.run.experiment import (
+from evolution.run.experiment import ExperimentError, load_experiment
+from evolution.run.presets import (
     CONFIG_DIR,
-    ExperimentError,
     is_preset_name,
-    load_experiment,
     preset_description,
     preset_names,
     preset_path,

@@ -15,13 +15,8 @@ from evolution.cli import evolve_main
 from evolution.encodings.substrate import Substrate
 from evolution.run import backends
 from evolution.run.evaluate import Evaluation, episode_seeds, trial_seed
-from evolution.run.experiment import (
-    ExperimentError,
-    experiment_from_run,
-    load_experiment,
-    preset_text,
-    resolve_preset,
-)
+from evolution.run.experiment import ExperimentError, experiment_from_run, load_experiment
+from evolution.run.presets import preset_text, resolve_preset
 from evolution.run.protocol import ORIGINAL, protocol_values
 from evolution.run.recorder import convergence_target
 from evolution.run.stats import read_stats, without_work

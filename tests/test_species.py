@@ -19,8 +19,9 @@ from evolution.reproduction.species import (
     original_distance,
     target_count,
 )
-from evolution.run.experiment import CONFIG_DIR, load_experiment
+from evolution.run.experiment import load_experiment
 from evolution.run.neat_setup import make_neat_config
+from evolution.run.presets import CONFIG_DIR
 
 CFG = CONFIG_DIR / "hyperneat_m.neat.cfg"
 
