@@ -173,7 +173,7 @@ def test_original_rule_moves_by_a_hundredth_at_its_bounds(tmp_path):
 
 
 def test_original_spawn_by_hand():
-    from evolution.reproduction.breeding import original_spawn
+    from evolution.reproduction.encog import original_spawn
 
     # shares 10, 0, 5, 0.2 of 15.2 over 9 places: 5.92 -> 6, 0, 2.96 -> 3, 0.12 -> 0 (dies)
     assert original_spawn([10, 0, 5, 0.2], [10, 0, 15, 0.2], 0, 9) == [6, 0, 3, 0]

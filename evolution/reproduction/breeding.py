@@ -47,6 +47,13 @@ import neat
 from neat.config import ConfigParameter, DefaultClassConfig
 from neat.math_util import mean
 
+from evolution.reproduction.encog import (
+    ORIGINAL_ELITE_MIN_MEMBERS,
+    ORIGINAL_ELITE_RATE,
+    original_leader,
+    original_spawn,
+)
+
 VARIATIONS = ("one_operator", "neat_python")
 WEIGHT_LINK_CHOICES = (1, 2, 3, 0.02)  # links perturbed or reset by one weight operation
 
@@ -206,72 +213,6 @@ def breed(candidates: list[int], genomes: dict[int, Any], score: dict[int, float
             child.mutate(gcfg)
         children[key] = child
     return children
-
-
-#: Encog's species elitism in the original's single-objective runs (``SingleObjectiveEA``'s
-#: elite rate: the best fraction of every species of more than 5 genomes survives as it is). The
-#: 2018 code that has the paper's convergence stop, time bonus 20 and 5 trials sets it to 0 (only
-#: the ratchet's best genome survives); the commit that removed the stop (2018-12-03) set 0.2.
-#: ``[NEATReproduction] original_elite_rate`` overrides it.
-ORIGINAL_ELITE_RATE, ORIGINAL_ELITE_MIN_MEMBERS = 0.0, 5
-#: Encog's stagnation in its speciation: a species is removed after more than 15 generations
-#: without improvement (neat-python's ``max_stagnation`` counts to 16), except the species of the
-#: best genome (``ThresholdSpeciation.removeSpecies``), whatever the other species score: so no
-#: species is spared for its fitness (``species_elitism`` 0) and ``NEATReproduction`` spares that one.
-ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM = 16, 0
-
-
-def original_leader(members: dict[int, Any], incumbent: int) -> int:
-    """Encog's species leader after a generation (``ThresholdSpeciation.addSpeciesMember``).
-
-    The species starts from its leader (``incumbent``: the one it was speciated against, or its
-    founder), members join in key order, and a member takes over only when it scores *strictly*
-    higher than the leader so far: the incumbent keeps the place on a tie, else the lowest key of
-    the best score wins. (Ranking by score alone hands a tie to a new offspring; with elite rate
-    0 that offspring is not carried, so the species is disbanded at the next speciation.)
-    """
-    top = max(g.fitness for g in members.values())
-    if incumbent in members and members[incumbent].fitness >= top:
-        return incumbent
-    return min(k for k, g in members.items() if g.fitness >= top)
-
-
-def java_round(x: float) -> int:
-    """Java's ``Math.round`` (halves round up), as Encog rounds offspring shares."""
-    return int(math.floor(x + 0.5))
-
-
-def original_spawn(means: list[float], bests: list[float], best: int, places: int) -> list[int]:
-    """Encog's offspring counts per species (``ThresholdSpeciation``), 0 for a species that dies.
-
-    ``means``: each species' mean score (its share; negative counts as 0), ``bests``: its best
-    score, ``best``: index of the species holding the best genome, ``places``: offspring to
-    place. Each species gets ``round(share / total * places)``; a species whose count rounds to 0
-    dies (not the best one, which gets at least 1); with every share 0 each gets
-    ``round(places / n)``. Then *level off*: species ordered by best score, the first gets at
-    least 1; a surplus is taken from the last species backwards (never the first), a shortfall
-    goes to the first.
-    """
-    n = len(means)
-    shares = [max(0.0, m) for m in means]
-    total = sum(shares)
-    if total < 1e-7:  # Encog.DEFAULT_DOUBLE_EQUAL
-        counts = [java_round(places / n)] * n
-    else:
-        counts = [java_round(share / total * places) for share in shares]
-        counts[best] = max(counts[best], 1)
-    order = sorted((i for i in range(n) if counts[i] > 0), key=lambda i: (-bests[i], i))
-    counts[order[0]] = max(counts[order[0]], 1)
-    diff = places - sum(counts)
-    if diff < 0:
-        for i in reversed(order[1:]):
-            take = min(counts[i], -diff)
-            counts[i] -= take
-            diff += take
-            if diff == 0:
-                break
-    counts[order[0]] += max(diff, 0)
-    return counts
 
 
 class NEATReproduction(neat.DefaultReproduction):

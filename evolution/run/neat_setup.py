@@ -63,7 +63,7 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
         if experiment.speciation == "original":
             use_original_rule(species, experiment.multi_objective, experiment.population)
             if not experiment.multi_objective:  # Encog's stagnation (NEATReproduction's Encog selection)
-                from evolution.reproduction.breeding import ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM
+                from evolution.reproduction.encog import ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM
 
                 config.stagnation_config.max_stagnation = ORIGINAL_MAX_STAGNATION
                 config.stagnation_config.species_elitism = ORIGINAL_SPECIES_ELITISM
