@@ -16,6 +16,10 @@ checks that the list and the pictures in docs/ are the same). The steps:
   docs/evidence/README.md);
 * ``evidence`` (docs/evidence/figure*.png, with the report they belong to): ``gathering-analyze``
   of those runs; needs ``--evidence DIR``;
+* ``original-m1-analysis`` (docs/evidence/original-M1/analysis-*/): ``gathering-analyze`` of the
+  original-protocol S1 and M1 runs, both ways (``--reevaluate 0`` and ``20``); needs
+  ``--original-runs DIR`` holding ``S1-original-continued`` and ``M1-original`` rebuilt from their
+  records (docs/evidence/original-M1/README.md);
 * ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
   docs/rl/README.md; needs ``--rl DIR`` (the runs) and the demo champion.
 
@@ -157,6 +161,21 @@ def make_original_s1_five(args: argparse.Namespace) -> None:
     record_curve("original-S1-five", "S1-original (version 3), five schedules a genome")
 
 
+ORIGINAL_M1_ANALYSES = {"analysis-training": "0", "analysis-heldout": "20"}  # folder -> --reevaluate
+
+
+def make_original_m1_analysis(args: argparse.Namespace) -> None:
+    """Table 4 and Figures 4-6 of the original-protocol M1 run beside the S1 run of its version,
+    scored on the training layout and held out (``--original-runs DIR``)."""
+    runs = (args.original_runs / "S1-original-continued", args.original_runs / "M1-original")
+    for folder, episodes in ORIGINAL_M1_ANALYSES.items():
+        with tempfile.TemporaryDirectory() as tmp:
+            report = Path(tmp) / "report"
+            run(*cli("gathering-analyze"), *runs, "--reevaluate", episodes, "--out", report)
+            for produced in sorted(report.iterdir()):
+                shutil.copy2(produced, DOCS / "evidence" / "original-M1" / folder / produced.name)
+
+
 LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
 LEARNING_RUN_FILES = ("stats.png", "stats.jsonl", "stats.csv", "experiment.json", "champion.json")
 
@@ -195,6 +214,8 @@ STEPS: dict[str, Step] = {
     "original-s1-shuffled": Step(("evidence/original-S1-shuffled/stats.png",), None,
                                  make_original_s1_shuffled),
     "original-s1-five": Step(("evidence/original-S1-five/stats.png",), None, make_original_s1_five),
+    "original-m1-analysis": Step(tuple(f"evidence/original-M1/{folder}/{f}" for folder in ORIGINAL_M1_ANALYSES
+                                       for f in EVIDENCE_FIGURES), "original_runs", make_original_m1_analysis),
     "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
                       "evidence/learning/M1/stats.png"), "learning", make_learning),
 }
@@ -220,6 +241,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="run directory of gathering-evolve S1-original: the original protocol's evidence")
     parser.add_argument("--marl", type=Path, default=None,
                         help="folder of the BenchMARL runs (examples/benchmarl_run.py): the IPPO/MAPPO figures")
+    parser.add_argument("--original-runs", type=Path, default=None,
+                        help="folder holding S1-original-continued and M1-original rebuilt from their records: "
+                             "the original-protocol M1 analysis")
     parser.add_argument("--learning", type=Path, default=None,
                         help="folder of make bench-learning (runs/bench-learning): the learning benchmark's figures")
     parser.add_argument("--evidence", type=Path, default=None,
@@ -230,7 +254,7 @@ def main(argv: list[str] | None = None) -> int:
     unknown = [s for s in chosen if s not in STEPS]
     if unknown:
         parser.error(f"--only {args.only}: unknown step {unknown[0]!r}; allowed: {', '.join(STEPS)}")
-    for key in ("original_s1", "marl", "learning", "evidence", "rl"):
+    for key in ("original_s1", "original_runs", "marl", "learning", "evidence", "rl"):
         folder = getattr(args, key)
         if folder is not None and not folder.is_dir():
             print(f"error: --{key.replace('_', '-')} {folder}: no such folder; allowed: an existing folder of runs",
@@ -240,6 +264,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: --original-s1 {args.original_s1}: no stats.jsonl; allowed: a run directory of "
               "gathering-evolve S1-original", file=sys.stderr)
         return 2
+    if args.original_runs is not None:
+        for run_name in ("S1-original-continued", "M1-original"):
+            if not (args.original_runs / run_name / "stats.jsonl").is_file():
+                print(f"error: --original-runs {args.original_runs}: no {run_name}/stats.jsonl; allowed: a folder "
+                      "holding S1-original-continued and M1-original rebuilt from their records", file=sys.stderr)
+                return 2
     for name in chosen:
         step = STEPS[name]
         if step.needs and getattr(args, step.needs) is None:

@@ -36,3 +36,12 @@ def test_pictures_in_docs_finds_nested_pictures(tmp_path):
     for name in ("x.png", "a/y.gif", "a/b/z.PNG", "a/notes.md"):
         (tmp_path / name).write_text("")
     assert load("docs_images").pictures_in_docs(tmp_path) == {"x.png", "a/y.gif", "a/b/z.PNG"}
+
+
+def test_original_runs_without_the_two_runs_is_refused_before_any_step(tmp_path, capsys):
+    (tmp_path / "M1-original").mkdir()
+    (tmp_path / "M1-original" / "stats.jsonl").write_text("")
+    assert load("docs_images").main(["--only", "original-m1-analysis", "--original-runs", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "no S1-original-continued/stats.jsonl" in err and err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["M1-original"]
