@@ -17,9 +17,12 @@ checks that the list and the pictures in docs/ are the same). The steps:
 * ``evidence`` (docs/evidence/figure*.png, with the report they belong to): ``gathering-analyze``
   of those runs; needs ``--evidence DIR``;
 * ``original-m1-analysis`` (docs/evidence/original-M1/analysis-*/): ``gathering-analyze`` of the
-  original-protocol S1 and M1 runs, both ways (``--reevaluate 0`` and ``20``); needs
+  original-protocol S1 and M1 runs of version 2, both ways (``--reevaluate 0`` and ``20``); needs
   ``--original-runs DIR`` holding ``S1-original-continued`` and ``M1-original`` rebuilt from their
-  records (docs/evidence/original-M1/README.md);
+  records (docs/evidence/original-M1/README.md); ``original-m1-five-analysis`` the same for
+  version 3 (``S1-original-five`` and ``M1-original-five``, docs/evidence/original-M1-five/);
+* ``original-m1-five`` (docs/evidence/original-M1-five/stats.png): that M1 run's curve, from its
+  committed record;
 * ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
   docs/rl/README.md; needs ``--rl DIR`` (the runs) and the demo champion.
 
@@ -162,18 +165,34 @@ def make_original_s1_five(args: argparse.Namespace) -> None:
 
 
 ORIGINAL_M1_ANALYSES = {"analysis-training": "0", "analysis-heldout": "20"}  # folder -> --reevaluate
+# step -> (S1 run, M1 run, docs/evidence folder): the M1 run beside the S1 run of its protocol version
+ORIGINAL_M1_PAIRS = {
+    "original-m1-analysis": ("S1-original-continued", "M1-original", "original-M1"),      # version 2
+    "original-m1-five-analysis": ("S1-original-five", "M1-original-five", "original-M1-five"),  # version 3
+}
 
 
-def make_original_m1_analysis(args: argparse.Namespace) -> None:
-    """Table 4 and Figures 4-6 of the original-protocol M1 run beside the S1 run of its version,
-    scored on the training layout and held out (``--original-runs DIR``)."""
-    runs = (args.original_runs / "S1-original-continued", args.original_runs / "M1-original")
-    for folder, episodes in ORIGINAL_M1_ANALYSES.items():
-        with tempfile.TemporaryDirectory() as tmp:
-            report = Path(tmp) / "report"
-            run(*cli("gathering-analyze"), *runs, "--reevaluate", episodes, "--out", report)
-            for produced in sorted(report.iterdir()):
-                shutil.copy2(produced, DOCS / "evidence" / "original-M1" / folder / produced.name)
+def original_m1_analysis(step: str) -> Callable[[argparse.Namespace], None]:
+    """Table 4 and Figures 4-6 of an original-protocol M1 run beside the S1 run of its version,
+    scored on the training layout and held out (``--original-runs DIR`` holds both runs)."""
+    s1, m1, target = ORIGINAL_M1_PAIRS[step]
+
+    def make(args: argparse.Namespace) -> None:
+        runs = (args.original_runs / s1, args.original_runs / m1)
+        for folder, episodes in ORIGINAL_M1_ANALYSES.items():
+            with tempfile.TemporaryDirectory() as tmp:
+                report = Path(tmp) / "report"
+                run(*cli("gathering-analyze"), *runs, "--reevaluate", episodes, "--out", report)
+                (DOCS / "evidence" / target / folder).mkdir(parents=True, exist_ok=True)
+                for produced in sorted(report.iterdir()):
+                    shutil.copy2(produced, DOCS / "evidence" / target / folder / produced.name)
+
+    return make
+
+
+def make_original_m1_five(args: argparse.Namespace) -> None:
+    """M1-original under version 3: five schedules a genome (kept going across sessions)."""
+    record_curve("original-M1-five", "M1-original (version 3), five schedules a genome")
 
 
 LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
@@ -214,8 +233,10 @@ STEPS: dict[str, Step] = {
     "original-s1-shuffled": Step(("evidence/original-S1-shuffled/stats.png",), None,
                                  make_original_s1_shuffled),
     "original-s1-five": Step(("evidence/original-S1-five/stats.png",), None, make_original_s1_five),
-    "original-m1-analysis": Step(tuple(f"evidence/original-M1/{folder}/{f}" for folder in ORIGINAL_M1_ANALYSES
-                                       for f in EVIDENCE_FIGURES), "original_runs", make_original_m1_analysis),
+    **{step: Step(tuple(f"evidence/{target}/{folder}/{f}" for folder in ORIGINAL_M1_ANALYSES
+                        for f in EVIDENCE_FIGURES), "original_runs", original_m1_analysis(step))
+       for step, (_, _, target) in ORIGINAL_M1_PAIRS.items()},
+    "original-m1-five": Step(("evidence/original-M1-five/stats.png",), None, make_original_m1_five),
     "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
                       "evidence/learning/M1/stats.png"), "learning", make_learning),
 }
@@ -242,8 +263,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--marl", type=Path, default=None,
                         help="folder of the BenchMARL runs (examples/benchmarl_run.py): the IPPO/MAPPO figures")
     parser.add_argument("--original-runs", type=Path, default=None,
-                        help="folder holding S1-original-continued and M1-original rebuilt from their records: "
-                             "the original-protocol M1 analysis")
+                        help="folder holding the original-protocol S1 and M1 runs rebuilt from their records "
+                             "(S1-original-continued and M1-original; S1-original-five and M1-original-five): "
+                             "the original-protocol M1 analyses")
     parser.add_argument("--learning", type=Path, default=None,
                         help="folder of make bench-learning (runs/bench-learning): the learning benchmark's figures")
     parser.add_argument("--evidence", type=Path, default=None,
@@ -265,11 +287,13 @@ def main(argv: list[str] | None = None) -> int:
               "gathering-evolve S1-original", file=sys.stderr)
         return 2
     if args.original_runs is not None:
-        for run_name in ("S1-original-continued", "M1-original"):
-            if not (args.original_runs / run_name / "stats.jsonl").is_file():
-                print(f"error: --original-runs {args.original_runs}: no {run_name}/stats.jsonl; allowed: a folder "
-                      "holding S1-original-continued and M1-original rebuilt from their records", file=sys.stderr)
-                return 2
+        for step in (step for step in chosen if step in ORIGINAL_M1_PAIRS):
+            s1, m1, _ = ORIGINAL_M1_PAIRS[step]
+            for run_name in (s1, m1):
+                if not (args.original_runs / run_name / "stats.jsonl").is_file():
+                    print(f"error: --original-runs {args.original_runs}: no {run_name}/stats.jsonl; allowed: a folder "
+                          f"holding {s1} and {m1} rebuilt from their records (step {step})", file=sys.stderr)
+                    return 2
     for name in chosen:
         step = STEPS[name]
         if step.needs and getattr(args, step.needs) is None:

@@ -45,3 +45,14 @@ def test_original_runs_without_the_two_runs_is_refused_before_any_step(tmp_path,
     err = capsys.readouterr().err
     assert "no S1-original-continued/stats.jsonl" in err and err.count("\n") == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["M1-original"]
+
+
+def test_original_runs_checks_the_runs_of_the_step_chosen(tmp_path, capsys):
+    # version 2's runs are present, version 3's S1 is not: only the version-3 step is refused
+    for name in ("S1-original-continued", "M1-original", "M1-original-five"):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "stats.jsonl").write_text("")
+    assert load("docs_images").main(["--only", "original-m1-five-analysis", "--original-runs", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "no S1-original-five/stats.jsonl" in err and "original-m1-five-analysis" in err and err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["M1-original", "M1-original-five", "S1-original-continued"]
