@@ -56,3 +56,15 @@ def test_original_runs_checks_the_runs_of_the_step_chosen(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "no S1-original-five/stats.jsonl" in err and "original-m1-five-analysis" in err and err.count("\n") == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["M1-original", "M1-original-five", "S1-original-continued"]
+
+
+def test_original_runs_does_not_ask_for_the_runs_of_a_step_not_chosen(tmp_path):
+    # only version 2's runs: its step runs (its make replaced by a recorder), version 3's are not asked for
+    for name in ("S1-original-continued", "M1-original"):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "stats.jsonl").write_text("")
+    module = load("docs_images")
+    made = []
+    module.STEPS["original-m1-analysis"] = module.Step((), "original_runs", made.append)
+    assert module.main(["--only", "original-m1-analysis", "--original-runs", str(tmp_path)]) == 0
+    assert [args.original_runs for args in made] == [tmp_path]
