@@ -139,29 +139,30 @@ def make_original_s1(args: argparse.Namespace) -> None:
                      title="S1-original")
 
 
-def record_curve(folder_name: str, title: str) -> None:
+# step -> (docs/evidence folder, title): runs kept going across sessions, whose curve is drawn
+# from their committed record (stats.jsonl) rather than from a run directory
+RECORD_CURVES = {
+    "original-s1-continued": ("original-S1-continued", "S1-original, continued"),
+    "original-s1-shuffled": ("original-S1-shuffled", "S1-original, force drive, shuffled schedule"),
+    "original-s1-five": ("original-S1-five", "S1-original (version 3), five schedules a genome"),
+    "original-s1-five-seed2": ("original-S1-five-seed2", "S1-original (version 3), five schedules, seed 2"),
+    "original-m1-five": ("original-M1-five", "M1-original (version 3), five schedules a genome"),
+}
+
+
+def record_curve(step: str) -> Callable[[argparse.Namespace], None]:
     """``stats.png`` of a run kept going across sessions, drawn from its committed record
-    (``docs/evidence/<folder_name>/stats.jsonl``)."""
-    from evolution.run.plots import plot_run
-    from evolution.run.stats import read_stats
+    (``docs/evidence/<folder>/stats.jsonl``)."""
+    folder_name, title = RECORD_CURVES[step]
 
-    folder = DOCS / "evidence" / folder_name
-    plot_run(read_stats(folder / "stats.jsonl"), folder / "stats.png", title=title)
+    def make(args: argparse.Namespace) -> None:
+        from evolution.run.plots import plot_run
+        from evolution.run.stats import read_stats
 
+        folder = DOCS / "evidence" / folder_name
+        plot_run(read_stats(folder / "stats.jsonl"), folder / "stats.png", title=title)
 
-def make_original_s1_continued(args: argparse.Namespace) -> None:
-    """The S1-original run continued to generation 250 (the velocity drive)."""
-    record_curve("original-S1-continued", "S1-original, continued")
-
-
-def make_original_s1_shuffled(args: argparse.Namespace) -> None:
-    """The S1-original run under the force drive and the shuffled schedule."""
-    record_curve("original-S1-shuffled", "S1-original, force drive, shuffled schedule")
-
-
-def make_original_s1_five(args: argparse.Namespace) -> None:
-    """S1-original under version 3: five schedules a genome (kept going across sessions)."""
-    record_curve("original-S1-five", "S1-original (version 3), five schedules a genome")
+    return make
 
 
 ORIGINAL_M1_ANALYSES = {"analysis-training": "0", "analysis-heldout": "20"}  # folder -> --reevaluate
@@ -188,11 +189,6 @@ def original_m1_analysis(step: str) -> Callable[[argparse.Namespace], None]:
                     shutil.copy2(produced, DOCS / "evidence" / target / folder / produced.name)
 
     return make
-
-
-def make_original_m1_five(args: argparse.Namespace) -> None:
-    """M1-original under version 3: five schedules a genome (kept going across sessions)."""
-    record_curve("original-M1-five", "M1-original (version 3), five schedules a genome")
 
 
 LEARNING_FILES = ("learning.png", "learning.json", "learning.md")
@@ -228,15 +224,11 @@ STEPS: dict[str, Step] = {
     "rl": Step(tuple(f"rl/{f}" for f in (*RL_FIGURES, *RL_CURVES)), "rl", make_rl),
     "marl": Step(("rl/curves-marl-env1.png",), "marl", make_marl),
     "original-s1": Step(("evidence/original-S1/stats.png",), "original_s1", make_original_s1),
-    "original-s1-continued": Step(("evidence/original-S1-continued/stats.png",), None,
-                                  make_original_s1_continued),
-    "original-s1-shuffled": Step(("evidence/original-S1-shuffled/stats.png",), None,
-                                 make_original_s1_shuffled),
-    "original-s1-five": Step(("evidence/original-S1-five/stats.png",), None, make_original_s1_five),
+    **{step: Step((f"evidence/{folder}/stats.png",), None, record_curve(step))
+       for step, (folder, _) in RECORD_CURVES.items()},
     **{step: Step(tuple(f"evidence/{target}/{folder}/{f}" for folder in ORIGINAL_M1_ANALYSES
                         for f in EVIDENCE_FIGURES), "original_runs", original_m1_analysis(step))
        for step, (_, _, target) in ORIGINAL_M1_PAIRS.items()},
-    "original-m1-five": Step(("evidence/original-M1-five/stats.png",), None, make_original_m1_five),
     "learning": Step(("evidence/learning/learning.png", "evidence/learning/S1/stats.png",
                       "evidence/learning/M1/stats.png"), "learning", make_learning),
 }
