@@ -21,8 +21,9 @@ checks that the list and the pictures in docs/ are the same). The steps:
   ``--original-runs DIR`` holding ``S1-original-continued`` and ``M1-original`` rebuilt from their
   records (docs/evidence/original-M1/README.md); ``original-m1-five-analysis`` the same for
   version 3 (``S1-original-five`` and ``M1-original-five``, docs/evidence/original-M1-five/);
-* ``original-m1-five`` (docs/evidence/original-M1-five/stats.png): that M1 run's curve, from its
-  committed record;
+* ``original-s1-continued``, ``original-s1-five``, ``original-s1-five-seed2``, ``original-m1-five``
+  and the other steps of ``RECORD_CURVES`` (docs/evidence/<folder>/stats.png): the curve of a run
+  kept going across sessions, drawn from its committed record (stats.jsonl);
 * ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
   docs/rl/README.md; needs ``--rl DIR`` (the runs) and the demo champion.
 
