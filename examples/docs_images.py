@@ -269,6 +269,10 @@ def main(argv: list[str] | None = None) -> int:
     unknown = [s for s in chosen if s not in STEPS]
     if unknown:
         parser.error(f"--only {args.only}: unknown step {unknown[0]!r}; allowed: {', '.join(STEPS)}")
+    if not chosen:
+        parser.error(f"--only {args.only!r}: names no step; allowed: a comma-separated list of {', '.join(STEPS)}")
+    if args.champion is not None and not args.champion.is_file():
+        parser.error(f"--champion {args.champion}: no such file; allowed: a champion.json of gathering-evolve")
     for key in ("original_s1", "original_runs", "marl", "learning", "evidence", "rl"):
         folder = getattr(args, key)
         if folder is not None and not folder.is_dir():

@@ -68,3 +68,35 @@ def test_original_runs_does_not_ask_for_the_runs_of_a_step_not_chosen(tmp_path):
     module.STEPS["original-m1-analysis"] = module.Step((), "original_runs", made.append)
     assert module.main(["--only", "original-m1-analysis", "--original-runs", str(tmp_path)]) == 0
     assert [args.original_runs for args in made] == [tmp_path]
+
+
+def test_an_only_that_names_no_step_is_refused_and_runs_nothing(capsys):
+    module = load("docs_images")
+    made = []
+    for name in list(module.STEPS):
+        module.STEPS[name] = module.Step((), None, made.append)
+    for only in (",", " , ", ""):
+        try:
+            module.main(["--only", only])
+        except SystemExit as stop:
+            assert stop.code == 2
+        else:
+            raise AssertionError(f"--only {only!r} was accepted")
+        assert "names no step" in capsys.readouterr().err
+    assert made == []
+
+
+def test_a_champion_that_is_not_a_file_is_refused_before_any_step(tmp_path, capsys):
+    module = load("docs_images")
+    made = []
+    module.STEPS["gallery"] = module.Step((), None, made.append)
+    for champion in (tmp_path / "missing.json", tmp_path):
+        try:
+            module.main(["--only", "gallery", "--champion", str(champion)])
+        except SystemExit as stop:
+            assert stop.code == 2
+        else:
+            raise AssertionError(f"--champion {champion} was accepted")
+        err = capsys.readouterr().err
+        assert "--champion" in err and "no such file" in err
+    assert made == [] and list(tmp_path.iterdir()) == []
