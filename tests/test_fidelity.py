@@ -196,6 +196,68 @@ def test_truncation_keeps_the_best_30_percent(tmp_path):
     assert used == {1, 2, 3}
 
 
+@pytest.mark.parametrize("n, neat_keep, encog_keep", [
+    (1, 1, 1), (3, 2, 1), (4, 2, 1), (6, 2, 1), (7, 3, 2), (10, 3, 3), (11, 4, 3), (20, 6, 6), (40, 12, 12)])
+def test_encog_truncation_floors_where_neat_python_rounds_up(n, neat_keep, encog_keep):
+    # by hand: neat-python max(ceil(0.3 n), 2), Encog's TruncationSelection max(floor(0.3 n), 1)
+    assert len(truncate(list(range(n)), 0.3)) == min(neat_keep, n)
+    assert truncate(list(range(n)), 0.3, "encog") == list(range(encog_keep))
+
+
+def breed_counts(config, genomes, n, seed=4):
+    """(children that crossed over, parents used) of ``n`` offspring of ``genomes`` (1 is best)."""
+    random.seed(seed)
+    ancestors = {}
+    keys = iter(range(100, 10**6))
+    score = {k: float(100 - k) for k in genomes}
+    breed(sorted(genomes, key=lambda k: -score[k]), genomes, score, n, config, lambda: next(keys), ancestors)
+    return sum(len(a) == 2 for a in ancestors.values()), {p for a in ancestors.values() for p in a}
+
+
+def test_under_encog_truncation_a_small_species_breeds_from_its_best_alone(tmp_path, monkeypatch):
+    config = breed_config(tmp_path)
+    genomes = parents(config, 6)                               # 0.3 * 6 = 1.8: Encog keeps 1, neat-python 2
+    crossed, used = breed_counts(config, genomes, 400)
+    assert used == {1, 2} and 150 < crossed < 250              # crossover 0.5 between the best two
+    config.genome_config.truncation = "encog"
+    mutated = Counter()
+    original = BreedingGenome.apply_operator
+    monkeypatch.setattr(BreedingGenome, "apply_operator",
+                        lambda self, name, cfg: (mutated.update([name]), original(self, name, cfg)))
+    crossed, used = breed_counts(config, genomes, 400)
+    assert used == {1} and crossed == 0                        # copies of the best, no crossover ...
+    assert sum(mutated.values()) == 400 and "crossover" not in mutated   # ... each changed by one mutation
+
+
+def test_an_encog_crossover_that_draws_one_parent_twice_draws_another_operator(tmp_path, monkeypatch):
+    """Encog draws the second parent up to 6 times; if each repeats the first there is no
+    child and another operator is drawn. With one draw and 2 parents that fails half the
+    time, so crossover's share falls from 0.5 to 0.25 / (0.25 + 0.5) = 1/3 (by hand)."""
+    import evolution.reproduction.breeding as breeding
+
+    config = breed_config(tmp_path)
+    config.genome_config.truncation = "encog"
+    genomes = parents(config, 7)                               # 0.3 * 7 = 2.1: 2 parents
+    n = 3000
+    crossed, used = breed_counts(config, genomes, n)
+    assert used == {1, 2} and abs(crossed - n * 63 / 127) < 4 * math.sqrt(n / 4)   # 6 draws: 63/127
+    monkeypatch.setattr(breeding, "ENCOG_PARENT_DRAWS", 1)
+    crossed, _ = breed_counts(config, genomes, n)
+    assert abs(crossed - n / 3) < 4 * math.sqrt(n * 2 / 9)
+
+
+def test_the_experiment_sets_the_truncation_both_arms_breed_with(tmp_path):
+    from evolution.run.experiment import load_experiment
+    from evolution.run.neat_setup import make_neat_config
+
+    for body, objectives, rule in (("", '["task"]', "neat"), ('protocol = "original"', '["task"]', "encog"),
+                                   ('truncation = "encog"', '["task", "morphology"]', "encog"),
+                                   ('protocol = "original"\nprotocol_version = 3', '["task"]', "neat")):
+        path = tmp_path / "e.toml"
+        path.write_text(f"[experiment]\nobjectives = {objectives}\npopulation = 10\n{body}\n")
+        assert make_neat_config(load_experiment(path)).genome_config.truncation == rule, body
+
+
 def test_weight_operator_changes_one_to_three_links(tmp_path):
     config = breed_config(tmp_path)
     genome = parents(config, 1)[1]

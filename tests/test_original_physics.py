@@ -166,7 +166,7 @@ def test_the_fidelity_pages_pushing_table_is_what_the_scenes_measure_today():
 
 
 def test_the_scenes_shuffled_world_is_the_physics_of_the_newest_bundle():
-    # the fidelity page's last column is what protocol = "original" (version 3) runs
+    # the fidelity page's last column is what protocol = "original" (version 3 and on) runs
     root = Path(__file__).resolve().parents[1]
     spec = importlib.util.spec_from_file_location("physics_scenes", root / "examples" / "physics_scenes.py")
     scenes = importlib.util.module_from_spec(spec)

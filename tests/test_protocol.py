@@ -146,14 +146,18 @@ def test_the_versions_of_the_original_bundle():
                        "drive_dead_band": 0.28}
     assert v3 == {k: v for k, v in v2.items() if k not in ("robot_drive_force", "robot_max_speed", "drive_dead_band")} \
         | {"drive_model": "force", "damping": 0.1, "schedule": "shuffled"}
-    assert protocol_values("original") == protocol_values("original", 3) and ORIGINAL["environment"] == v3
+    v4 = protocol_values("original", 4)
+    assert v4["environment"] == v3 and v4["substrate"] == protocol_values("original", 3)["substrate"]
+    assert v4["experiment"] == protocol_values("original", 3)["experiment"] | {"truncation": "encog"}
+    assert protocol_values("original") == v4 and ORIGINAL["environment"] == v3
     # "paper" names the defaults of every key any version sets
     paper = protocol_values("paper")["environment"]
     assert (paper["drive_model"], paper["damping"], paper["schedule"], paper["drive_dead_band"],
             paper["robot_max_speed"], paper["ground_friction"]) == ("velocity", 0.0, "fixed", 0.0, 0.5, "threshold")
+    assert protocol_values("paper")["experiment"]["truncation"] == "neat"
 
 
-@pytest.mark.parametrize("version", [1, 2, 3])
+@pytest.mark.parametrize("version", [1, 2, 3, 4])
 def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path, version):
     exp = load_experiment(experiment(tmp_path, body=f'protocol = "original"\nprotocol_version = {version}'))
     saved = exp.to_dict()
@@ -161,6 +165,7 @@ def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path,
     del saved["protocol_version"]                   # experiment.json as it was written before versions
     again = experiment_from_run(saved, "experiment.json")
     assert again.protocol_version == version and again.environment == exp.environment
+    assert again.truncation == exp.truncation == ("encog" if version >= 4 else "neat")
     assert again.world_config() == exp.world_config()
 
 
@@ -175,9 +180,12 @@ def test_the_committed_records_rebuild_in_the_world_they_were_run_in(folder, ver
 
 
 def test_the_five_schedule_record_is_the_s1_original_preset():
+    """... as the preset was at version 3, under which it ran (version 4 adds Encog's truncation)."""
     record = load_experiment(EVIDENCE / "original-S1-five" / "experiment.toml")
-    preset = load_experiment(*resolve_preset("S1-original"))
-    assert (record.protocol, preset.protocol_version) == (None, 3)
+    path, overrides = resolve_preset("S1-original")
+    preset = load_experiment(path, {**(overrides or {}), "protocol_version": 3})
+    assert (record.protocol, preset.protocol_version, record.truncation) == (None, 3, "neat")
+    assert load_experiment(path, overrides).truncation == "encog"
     mine = {k: v for k, v in record.to_dict().items() if k not in ("name", "source", "protocol", "protocol_version")}
     theirs = {k: v for k, v in preset.to_dict().items() if k not in ("name", "source", "protocol", "protocol_version")}
     assert mine == theirs
@@ -185,7 +193,7 @@ def test_the_five_schedule_record_is_the_s1_original_preset():
 
 @pytest.mark.parametrize("body, needle", [
     ('protocol = "original"\nprotocol_version = 7', "[experiment] protocol_version=7; allowed for protocol = "
-                                                     "'original': [1, 2, 3]"),
+                                                     "'original': [1, 2, 3, 4]"),
     ('protocol = "original"\nprotocol_version = true', "protocol_version=True; allowed for protocol = 'original'"),
     ('protocol = "paper"\nprotocol_version = 2', "[experiment] protocol_version=2; allowed for protocol = 'paper': [1]"),
     ("protocol_version = 2", "[experiment] protocol_version=2 without a protocol; allowed: with protocol"),
@@ -329,7 +337,7 @@ def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_pa
     assert len(whole) == 4 and part == whole
     saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
     assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0
-    assert saved["protocol_version"] == 3 and saved["environment"]["schedule"] == "shuffled"
+    assert saved["protocol_version"] == 4 and saved["truncation"] == "encog" and saved["environment"]["schedule"] == "shuffled"
     shutil.rmtree(tmp_path / "part")
 
 

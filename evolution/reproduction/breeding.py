@@ -7,15 +7,20 @@ each species' offspring with ``breed``, so Table 4 compares selection and nothin
 ``breed`` (docs/model.md §5 and §6.5, the original's Encog scheme):
 
 1. **truncation**: the species' candidates, best first by the arm's score (fitness in SO,
-   NSGA-II rank score in MO), are cut to the best ``parent_fraction`` (0.3), at least two
-   where the species has two;
+   NSGA-II rank score in MO), are cut to the best ``parent_fraction`` f (0.3). How many that
+   is, is the experiment's ``truncation`` (``config.genome_config.truncation``): ``"neat"``
+   (the default, neat-python's rule) keeps ceil(f n), at least two where the species has
+   two; ``"encog"`` (the original code's ``TruncationSelection``) keeps max(floor(f n), 1),
+   so a species of fewer than 7 genomes breeds from its best genome alone;
 2. each offspring gets **one operator**, drawn in proportion to its probability:
    ``crossover`` (two distinct parents; matching genes from either, disjoint and excess genes
    from the parent with the better score, so in MO the better-ranked one), or a copy of one
    parent changed by exactly one mutation operator of the genome class (``weights``,
    ``add_node``, ``add_link``, ``remove_link``, ``remove_node``; NEAT-M adds its sensor
    operators). A species with a single parent cannot cross over: a drawn crossover becomes
-   a mutation operator drawn from the others.
+   a mutation operator drawn from the others. Under ``"encog"`` truncation a crossover with
+   k parents also fails, as Encog's does, when six draws of the second parent (with
+   replacement) all repeat the first (probability k^-6), and the operator is drawn again.
 
 The probabilities live in the genome's config section (they differ between HyperNEAT-M and
 NEAT-M, and a genome class knows its operators)::
@@ -55,6 +60,8 @@ from evolution.reproduction.encog import (
 )
 
 VARIATIONS = ("one_operator", "neat_python")
+TRUNCATIONS = ("neat", "encog")  # how many of a species' best parent_fraction breed (see truncate)
+ENCOG_PARENT_DRAWS = 6  # Encog's draws of a second parent different from the first (1 + 5 retries)
 WEIGHT_LINK_CHOICES = (1, 2, 3, 0.02)  # links perturbed or reset by one weight operation
 
 
@@ -166,9 +173,13 @@ class _Scored:
         return getattr(self._genome, name)
 
 
-def truncate(candidates: list[int], fraction: float) -> list[int]:
-    """The best ``fraction`` of ``candidates`` (sorted best first), at least two where possible."""
-    keep = max(int(math.ceil(fraction * len(candidates))), min(2, len(candidates)))
+def truncate(candidates: list[int], fraction: float, rule: str = "neat") -> list[int]:
+    """The best ``fraction`` of ``candidates`` (sorted best first): ceil(fraction n), at least
+    two where possible (``rule = "neat"``), or max(floor(fraction n), 1) (``"encog"``)."""
+    if rule == "encog":
+        keep = max(int(fraction * len(candidates)), 1)  # Java's (int) cast of the same double
+    else:
+        keep = max(int(math.ceil(fraction * len(candidates))), min(2, len(candidates)))
     return candidates[:keep]
 
 
@@ -183,7 +194,8 @@ def breed(candidates: list[int], genomes: dict[int, Any], score: dict[int, float
         ancestors: filled with child id -> parent ids.
     """
     gcfg = config.genome_config
-    parents = truncate(candidates, gcfg.parent_fraction)
+    rule = getattr(gcfg, "truncation", "neat")
+    parents = truncate(candidates, gcfg.parent_fraction, rule)
     ops = config.genome_type.operators(gcfg)
     names, weights = [n for n, _ in ops], [w for _, w in ops]
     children: dict[int, Any] = {}
@@ -192,7 +204,11 @@ def breed(candidates: list[int], genomes: dict[int, Any], score: dict[int, float
         child = config.genome_type(key)
         if gcfg.variation == "one_operator":
             op = random.choices(names, weights)[0]
-            if op == "crossover" and len(parents) < 2 and sum(weights[1:]) > 0:
+            if rule == "encog" and sum(weights[1:]) > 0:
+                while op == "crossover" and (len(parents) < 2
+                                             or random.random() < len(parents) ** -ENCOG_PARENT_DRAWS):
+                    op = random.choices(names, weights)[0]  # Encog: no child, another operator
+            elif op == "crossover" and len(parents) < 2 and sum(weights[1:]) > 0:
                 op = random.choices(names[1:], weights[1:])[0]  # one parent: a mutation instead
             crossover = op == "crossover"
         else:

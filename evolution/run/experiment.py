@@ -24,6 +24,8 @@ Layout (every key optional except where noted; defaults are the paper's, docs/mo
                                  # "ratchet" (SO): only the best-ever genome is carried over,
                                  # with its stored score, never re-evaluated (the original code)
     complexity = "paper"         # eq. 2: "paper" or "original" (gathering_env.morphological_complexity)
+    truncation = "neat"          # how many of a species' best parent_fraction breed: "neat" (ceil,
+                                 # at least two) or "encog" (floor, at least one: the original code)
 
     [environment]                # any gathering_env keyword: environment, max_cycles, ...
     environment = 2
@@ -51,6 +53,7 @@ from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
+from evolution.reproduction.breeding import TRUNCATIONS
 from evolution.run.presets import CONFIG_DIR, DEFAULT_NEAT_CONFIGS
 from evolution.run.protocol import PROTOCOLS, apply_protocol, newest_version, saved_version, versions
 from gathering_env.config import WorldConfig
@@ -79,7 +82,8 @@ def _species_modes() -> tuple[str, ...]:
 
 #: Keys whose value is one of a few names.
 CHOICES = {"method": lambda: METHODS, "speciation": _species_modes, "protocol": lambda: PROTOCOLS,
-           "layout": lambda: LAYOUTS, "elitism": lambda: ELITISM, "complexity": lambda: COMPLEXITY_FORMULAS}
+           "layout": lambda: LAYOUTS, "elitism": lambda: ELITISM, "complexity": lambda: COMPLEXITY_FORMULAS,
+           "truncation": lambda: TRUNCATIONS}
 
 
 class ExperimentError(ValueError):
@@ -104,6 +108,7 @@ class Experiment:
     layout: str = "per_trial"
     elitism: str = "species"
     complexity: str = "paper"
+    truncation: str = "neat"  # evolution.reproduction.breeding.truncate
     neat_config: Path = field(default_factory=lambda: CONFIG_DIR / DEFAULT_NEAT_CONFIGS["hyperneat-m"])
     environment: dict[str, Any] = field(default_factory=lambda: {"environment": 2, "max_cycles": 10_000})
     substrate: dict[str, Any] = field(default_factory=dict)

@@ -57,6 +57,7 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
         # the experiment's elitism: "ratchet" carries the best-ever genome, unscored (NEATReproduction)
         config.reproduction_config.ratchet = experiment.elitism == "ratchet"
     config.pop_size = experiment.population
+    config.genome_config.truncation = experiment.truncation  # read by breeding.breed, both arms
     species = config.species_set_config
     if experiment.speciation is not None:
         species.species_mode = experiment.speciation

@@ -16,6 +16,9 @@ key                           paper (default)     original
                                                   carried over, unchanged and never re-scored
                                                   (with Encog's selection its species elites too)
 ``[experiment] complexity``   ``"paper"``         ``"original"``: eq. 2 as the code computed it
+``[experiment] truncation``   ``"neat"``          ``"encog"``: Encog's truncation, the best
+                                                  max(floor(0.3 n), 1) of a species breed
+                                                  (``evolution.reproduction.breeding``)
 ``[experiment] speciation``   (the neat config's  ``"original"``: Encog's distance and threshold
                               ``species_mode``)   rule (``evolution.reproduction.species``); in SO
                                                   also Encog's species of leaders, offspring
@@ -54,10 +57,14 @@ newest one whose keys it holds with the same values (``saved_version``). The ori
    the velocity drive models it: net push at a standstill 3.63, top speed 0.637, dead band 0.28
    (``robot_drive_force``, ``robot_max_speed``, ``drive_dead_band``). With a fixed order the
    simulator is deterministic, so each genome ran its one layout once.
-3. (2026-12, the newest) the original robot itself (``drive_model = "force"``, ``damping = 0.1``)
+3. (2026-12) the original robot itself (``drive_model = "force"``, ``damping = 0.1``)
    in place of version 2's velocity-drive keys, and its MASON schedule (``schedule =
    "shuffled"``): with these the scripted pushing scenes match the original's own classes, and
    the run's trials share its layout and differ by schedule, as the original's five did.
+4. (2026-12, the newest) adds Encog's truncation (``truncation = "encog"``): the 2018 code's
+   ``TruncationSelection(0.3)`` keeps max(floor(0.3 n), 1) of a species as parents where the
+   earlier versions kept ceil(0.3 n) and at least two, so in the original a species of fewer
+   than 7 genomes breeds from its best genome alone, by mutation.
 
 ``protocol = "paper"`` names the defaults (one version). A file that names a protocol and sets
 one of its keys to another value is refused (``ExperimentError`` naming the file and key);
@@ -84,6 +91,9 @@ ORIGINAL_FORCE_DRIVE = {"drive_model": "force", "damping": 0.1}
 #: The original's MASON schedule, on top of the force drive (``gathering_env.drive.shuffled_times``).
 ORIGINAL_SCHEDULE = {"schedule": "shuffled"}
 
+#: Encog's truncation selection (version 4; ``evolution.reproduction.breeding.truncate``).
+ORIGINAL_TRUNCATION = {"truncation": "encog"}
+
 #: Protocol name -> version -> {section: {key: value}}; the "paper" values are the defaults of
 #: the dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``), filled in
 #: by ``protocol_values``.
@@ -94,6 +104,9 @@ BUNDLES: dict[str, dict[int, dict[str, dict[str, Any]]]] = {
             "substrate": _SUBSTRATE},
         3: {"experiment": _METHOD, "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE,
                                                    **ORIGINAL_SCHEDULE},
+            "substrate": _SUBSTRATE},
+        4: {"experiment": {**_METHOD, **ORIGINAL_TRUNCATION},
+            "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE},
             "substrate": _SUBSTRATE},
     },
     "paper": {1: {}},
@@ -112,7 +125,7 @@ ORIGINAL_PHYSICS = (*_CONTACTS, *ORIGINAL_VELOCITY_DRIVE)
 DESCRIPTIONS = {
     "paper": "the paper's text (the defaults)",
     "original": "the 2018 Java code that produced the published figures: one layout per run, ratchet on the best "
-                "genome, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its eq. 2, its "
+                "genome, Encog's truncation, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its eq. 2, its "
                 "physics (mass friction, bouncing contacts) and its robot on its shuffled schedule",
 }
 
@@ -205,5 +218,6 @@ def apply_protocol(name: str, sections: dict[str, dict[str, Any]], source: str,
 
 
 __all__ = ["BUNDLES", "DESCRIPTIONS", "ORIGINAL", "ORIGINAL_FORCE_DRIVE", "ORIGINAL_PHYSICS", "ORIGINAL_SCHEDULE",
+           "ORIGINAL_TRUNCATION",
            "ORIGINAL_VELOCITY_DRIVE", "PROTOCOLS", "apply_protocol", "newest_version", "protocol_values", "saved_version",
            "versions"]

@@ -78,6 +78,9 @@ def protocol_notes(exp: Experiment) -> list[str]:
                        "original_elite_rate > 0; the 2018 code's is 0) is carried over")
         notes.append(f"{exp.name}: ratchet (elitism = ratchet): {carried}, with stored scores, and not "
                      "evaluated again; only offspring are scored")
+    if exp.truncation == "encog":
+        notes.append(f"{exp.name}: Encog's truncation (truncation = encog): the best max(floor(f n), 1) genomes of a "
+                     "species of n breed (f = parent_fraction; at 0.3 a species of fewer than 7 breeds from its best alone)")
     return notes
 
 
