@@ -258,6 +258,92 @@ def test_the_experiment_sets_the_truncation_both_arms_breed_with(tmp_path):
         assert make_neat_config(load_experiment(path)).genome_config.truncation == rule, body
 
 
+@pytest.mark.parametrize("method, sigmas", [("hyperneat-m", (0.02, 1.0)), ("neat-m", (0.004, 0.2))])
+def test_the_original_protocol_sets_encog_weights_for_either_method(tmp_path, method, sigmas):
+    from evolution.run.experiment import load_experiment
+    from evolution.run.neat_setup import make_neat_config
+
+    path = tmp_path / "e.toml"
+    for body, encog in (("", False), ('protocol = "original"', True), ('weights = "encog"', True),
+                        ('protocol = "original"\nprotocol_version = 3', False)):
+        path.write_text(f'[experiment]\nmethod = "{method}"\npopulation = 10\n{body}\n')
+        gcfg = make_neat_config(load_experiment(path)).genome_config
+        assert getattr(gcfg, "encog_sigmas", None) == (sigmas if encog else None), body
+        assert (gcfg.weight_max_value, gcfg.bias_min_value, gcfg.weight_init_type) == \
+            ((5.0, -5.0, "uniform") if encog else (3.0, -3.0, "gaussian")), body
+
+
+def test_the_original_weights_are_uniform_in_plus_minus_5(tmp_path):
+    """Encog's initial weights: uniform in [-5, 5] (standard deviation 10 / sqrt(12) = 2.887 by
+    hand), where the shipped config draws N(0, 1) clamped to +-3."""
+    from evolution.reproduction.encog import use_encog_weights
+
+    config = load(CPPNGenome)
+    config.genome_config.innovation_tracker = neat.innovation.InnovationTracker()
+    before = [w for g in parents(config, 40).values() for w in [c.weight for c in g.connections.values()]]
+    use_encog_weights(config.genome_config, "hyperneat-m")
+    genomes = parents(config, 40)
+    weights = [c.weight for g in genomes.values() for c in g.connections.values()]
+    biases = [n.bias for g in genomes.values() for n in g.nodes.values()]
+    assert max(map(abs, before)) <= 3.0 and abs(np.std(before) - 1.0) < 0.15
+    for values in (weights, biases):
+        assert max(map(abs, values)) <= 5.0 and abs(np.std(values) - 10 / math.sqrt(12)) < 0.35
+        assert min(values) < -4.5 and max(values) > 4.5
+
+
+def weight_changes(genome, config, operations=3000, seed=2):
+    """The weight changes (|delta| of every link changed) of each of ``operations`` weight operations."""
+    random.seed(seed)
+    genome.fitness = 0.0
+    out = []
+    for _ in range(operations):
+        child = BreedingGenome(2)
+        child.configure_crossover(genome, genome, config.genome_config)
+        child.apply_operator("weights", config.genome_config)
+        delta = [abs(child.connections[k].weight - g.weight) for k, g in genome.connections.items()]
+        delta += [abs(child.nodes[k].bias - g.bias) for k, g in genome.nodes.items()]
+        out.append([d for d in delta if d > 0])
+    return out
+
+
+def test_the_original_weight_operation_perturbs_by_0_02_or_1(tmp_path):
+    """Encog's weight operation: 45 % of operations perturb by N(0, 0.02), 45 % by N(0, 1), 10 %
+    reset. So about half of them change no weight by 0.08 (4 sigma of the small one) or more;
+    with the shipped N(0, 0.5) about 13 % of single changes are that small."""
+    from evolution.reproduction.encog import use_encog_weights
+
+    config = breed_config(tmp_path)
+    genome = parents(config, 1)[1]
+    small = lambda changes: sum(max(c) < 0.08 for c in changes if c) / len(changes)  # noqa: E731
+    assert small(weight_changes(genome, config)) < 0.15
+    use_encog_weights(config.genome_config, "hyperneat-m")
+    genome = parents(config, 1)[1]
+    changes = weight_changes(genome, config)
+    assert 0.41 < small(changes) < 0.52
+    assert all(c for c in changes)                              # every operation changes a link
+
+
+def test_the_original_proportion_pick_draws_each_link_with_probability_0_02(tmp_path, monkeypatch):
+    """Encog's SelectProportion(0.02): each link with probability 0.02, one at random if none:
+    on 400 links the count varies (binomial, mean 8, variance 7.84); the shipped rule changes
+    round(0.02 * 400) = 8 every time."""
+    import evolution.reproduction.breeding as breeding
+    from evolution.reproduction.encog import use_encog_weights
+
+    path = tmp_path / "big.cfg"
+    path.write_text(BREED_CFG.format(crossover=0.5, weights=0.3, add_node=0.1, add_link=0.1)
+                    .replace("num_inputs = 4", "num_inputs = 100"))
+    config = load(BreedingGenome, path=path)
+    config.genome_config.innovation_tracker = neat.innovation.InnovationTracker()
+    genome = parents(config, 1)[1]
+    links = len(genome.connections) + len(genome.nodes)
+    use_encog_weights(config.genome_config, "hyperneat-m")
+    monkeypatch.setattr(breeding, "ENCOG_WEIGHT_OPERATIONS", ((0.02, 1, 1.0),))
+    counts = [len(c) for c in weight_changes(genome, config, 600)]
+    p = 0.02
+    assert abs(np.mean(counts) - links * p) < 0.5 and abs(np.var(counts) - links * p * (1 - p)) < 2.0
+
+
 def test_weight_operator_changes_one_to_three_links(tmp_path):
     config = breed_config(tmp_path)
     genome = parents(config, 1)[1]

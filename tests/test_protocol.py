@@ -148,13 +148,14 @@ def test_the_versions_of_the_original_bundle():
         | {"drive_model": "force", "damping": 0.1, "schedule": "shuffled"}
     v4 = protocol_values("original", 4)
     assert v4["environment"] == v3 and v4["substrate"] == protocol_values("original", 3)["substrate"]
-    assert v4["experiment"] == protocol_values("original", 3)["experiment"] | {"truncation": "encog"}
+    assert v4["experiment"] == protocol_values("original", 3)["experiment"] | {"truncation": "encog", "weights": "encog"}
     assert protocol_values("original") == v4 and ORIGINAL["environment"] == v3
     # "paper" names the defaults of every key any version sets
     paper = protocol_values("paper")["environment"]
     assert (paper["drive_model"], paper["damping"], paper["schedule"], paper["drive_dead_band"],
             paper["robot_max_speed"], paper["ground_friction"]) == ("velocity", 0.0, "fixed", 0.0, 0.5, "threshold")
-    assert protocol_values("paper")["experiment"]["truncation"] == "neat"
+    assert (protocol_values("paper")["experiment"]["truncation"], protocol_values("paper")["experiment"]["weights"]) \
+        == ("neat", "neat")
 
 
 @pytest.mark.parametrize("version", [1, 2, 3, 4])
@@ -165,7 +166,7 @@ def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path,
     del saved["protocol_version"]                   # experiment.json as it was written before versions
     again = experiment_from_run(saved, "experiment.json")
     assert again.protocol_version == version and again.environment == exp.environment
-    assert again.truncation == exp.truncation == ("encog" if version >= 4 else "neat")
+    assert again.truncation == exp.truncation == again.weights == ("encog" if version >= 4 else "neat")
     assert again.world_config() == exp.world_config()
 
 
@@ -184,8 +185,8 @@ def test_the_five_schedule_record_is_the_s1_original_preset():
     record = load_experiment(EVIDENCE / "original-S1-five" / "experiment.toml")
     path, overrides = resolve_preset("S1-original")
     preset = load_experiment(path, {**(overrides or {}), "protocol_version": 3})
-    assert (record.protocol, preset.protocol_version, record.truncation) == (None, 3, "neat")
-    assert load_experiment(path, overrides).truncation == "encog"
+    assert (record.protocol, preset.protocol_version, record.truncation, record.weights) == (None, 3, "neat", "neat")
+    assert (load_experiment(path, overrides).truncation, load_experiment(path, overrides).weights) == ("encog", "encog")
     mine = {k: v for k, v in record.to_dict().items() if k not in ("name", "source", "protocol", "protocol_version")}
     theirs = {k: v for k, v in preset.to_dict().items() if k not in ("name", "source", "protocol", "protocol_version")}
     assert mine == theirs
@@ -337,7 +338,7 @@ def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_pa
     assert len(whole) == 4 and part == whole
     saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
     assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0
-    assert saved["protocol_version"] == 4 and saved["truncation"] == "encog" and saved["environment"]["schedule"] == "shuffled"
+    assert saved["protocol_version"] == 4 and saved["truncation"] == saved["weights"] == "encog" and saved["environment"]["schedule"] == "shuffled"
     shutil.rmtree(tmp_path / "part")
 
 

@@ -53,6 +53,7 @@ from neat.config import ConfigParameter, DefaultClassConfig
 from neat.math_util import mean
 
 from evolution.reproduction.encog import (
+    ENCOG_WEIGHT_OPERATIONS,
     ORIGINAL_ELITE_MIN_MEMBERS,
     ORIGINAL_ELITE_RATE,
     original_leader,
@@ -144,10 +145,16 @@ class BreedingGenome(neat.DefaultGenome):
             raise ValueError(f"unknown variation operator {name!r}")
 
     def mutate_weights(self, config: Any) -> None:
-        """Perturb or reset 1, 2, 3 or 2 % of the links (enabled connections and node biases)."""
+        """Perturb or reset 1, 2, 3 or 2 % of the links (enabled connections and node biases);
+        with Encog's weights (``evolution.reproduction.encog.use_encog_weights``) one of its
+        weight operations."""
         links = [(g, "weight") for _, g in sorted(self.connections.items()) if g.enabled]
         links += [(g, "bias") for _, g in sorted(self.nodes.items())]
         if not links:
+            return
+        sigmas = getattr(config, "encog_sigmas", None)
+        if sigmas is not None:
+            self._mutate_weights_encog(links, sigmas, config)
             return
         pick = random.choice(WEIGHT_LINK_CHOICES)
         k = pick if isinstance(pick, int) else max(1, round(pick * len(links)))
@@ -159,6 +166,22 @@ class BreedingGenome(neat.DefaultGenome):
             else:
                 power = getattr(config, attribute.mutate_power_name)
                 value = attribute.clamp(getattr(gene, name) + random.gauss(0.0, power), config)
+            setattr(gene, name, value)
+
+    @staticmethod
+    def _mutate_weights_encog(links: list[tuple[Any, str]], sigmas: tuple[float, float], config: Any) -> None:
+        """One of Encog's weight operations (``ENCOG_WEIGHT_OPERATIONS``) on ``links``."""
+        count, sigma, _ = random.choices(ENCOG_WEIGHT_OPERATIONS, [w for *_, w in ENCOG_WEIGHT_OPERATIONS])[0]
+        if isinstance(count, int):
+            chosen = random.sample(links, min(count, len(links)))
+        else:  # each link with probability count, one at random if none was drawn
+            chosen = [link for link in links if random.random() < count] or [random.choice(links)]
+        for gene, name in chosen:
+            attribute = next(a for a in gene._gene_attributes if a.name == name)
+            if sigma is None:
+                value = attribute.init_value(config)  # uniform in the range (use_encog_weights)
+            else:
+                value = attribute.clamp(getattr(gene, name) + random.gauss(0.0, sigmas[sigma]), config)
             setattr(gene, name, value)
 
 

@@ -1,4 +1,4 @@
-"""Encog's single-objective selection, which the original protocol's SO runs use.
+"""Encog's single-objective selection and link weights, which the original protocol uses.
 
 The 2018 code ran NEAT through Encog; with ``speciation = "original"`` in an SO run,
 ``evolution.reproduction.breeding.NEATReproduction`` selects as Encog's ``ThresholdSpeciation``
@@ -7,6 +7,12 @@ its constants, the offspring counts per species (``original_spawn``, with Java's
 the species leader after a generation (``original_leader``). The speciation itself (distance,
 threshold) is ``evolution.reproduction.species``; docs/model.md and docs/fidelity.md say which
 runs use it.
+
+With ``weights = "encog"`` (``use_encog_weights``) link weights and biases follow the 2018 code's
+Encog populations: drawn uniformly in [-5, 5] (its ``getWeightRange()``, for both methods) and
+clamped there, and a weight operation is one of Encog's twelve (``ENCOG_WEIGHT_OPERATIONS``):
+perturb 1, 2, 3 links or each link with probability 0.02 (at least one) by a Gaussian of the
+method's small or large deviation, or reset them uniformly in the range.
 """
 
 from __future__ import annotations
@@ -25,6 +31,35 @@ ORIGINAL_ELITE_RATE, ORIGINAL_ELITE_MIN_MEMBERS = 0.0, 5
 #: best genome (``ThresholdSpeciation.removeSpecies``), whatever the other species score: so no
 #: species is spared for its fitness (``species_elitism`` 0) and ``NEATReproduction`` spares that one.
 ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM = 16, 0
+
+
+#: Encog's link-weight range in the 2018 code (its ``NEATPopulation.getWeightRange()`` returns 5.0
+#: for HyperNEAT-M's CPPN and NEAT-M's network alike): initial, added and reset weights are uniform
+#: in [-5, 5], and a perturbed weight is clamped to it.
+ENCOG_WEIGHT_RANGE = 5.0
+#: The Gaussian deviations of the original's weight perturbation, small and large, per method
+#: (``HyperNEATMUtil``: 0.02 and 1; ``NEATMUtil``: 0.004 and 0.2).
+ENCOG_PERTURB_SIGMAS = {"hyperneat-m": (0.02, 1.0), "neat-m": (0.004, 0.2)}
+#: The original's weight operation (a ``CompoundOperator``): (links, deviation index or None for a
+#: reset, probability). Links: a count of distinct links, or a float p: each link with probability
+#: p, one at random if none was drawn (``SelectProportion``).
+ENCOG_WEIGHT_OPERATIONS = tuple(
+    [(links, sigma, 0.1125) for sigma in (0, 1) for links in (1, 2, 3, 0.02)]
+    + [(1, None, 0.03), (2, None, 0.03), (3, None, 0.03), (0.02, None, 0.01)])
+
+
+def use_encog_weights(genome_config: Any, method: str) -> None:
+    """Set a neat-python genome config to the original's link weights (see the module docstring):
+    weights and biases initialised uniformly in +-``ENCOG_WEIGHT_RANGE`` and clamped there; the
+    weight operator (``BreedingGenome.mutate_weights``) draws from ``ENCOG_WEIGHT_OPERATIONS``
+    with the method's deviations. neat-python's ``uniform`` init draws in mean +- 2 stdev."""
+    for gene in ("weight", "bias"):
+        setattr(genome_config, f"{gene}_init_type", "uniform")
+        setattr(genome_config, f"{gene}_init_mean", 0.0)
+        setattr(genome_config, f"{gene}_init_stdev", ENCOG_WEIGHT_RANGE / 2)
+        setattr(genome_config, f"{gene}_min_value", -ENCOG_WEIGHT_RANGE)
+        setattr(genome_config, f"{gene}_max_value", ENCOG_WEIGHT_RANGE)
+    genome_config.encog_sigmas = ENCOG_PERTURB_SIGMAS[method]
 
 
 def original_leader(members: dict[int, Any], incumbent: int) -> int:

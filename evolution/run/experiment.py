@@ -26,6 +26,8 @@ Layout (every key optional except where noted; defaults are the paper's, docs/mo
     complexity = "paper"         # eq. 2: "paper" or "original" (gathering_env.morphological_complexity)
     truncation = "neat"          # how many of a species' best parent_fraction breed: "neat" (ceil,
                                  # at least two) or "encog" (floor, at least one: the original code)
+    weights = "neat"             # link weights: "neat" (the neat config's weight_/bias_ keys) or
+                                 # "encog" (the original's: uniform in +-5, its weight operations)
 
     [environment]                # any gathering_env keyword: environment, max_cycles, ...
     environment = 2
@@ -63,6 +65,7 @@ from gathering_env.world import GatheringWorld
 METHODS = ("hyperneat-m", "neat-m")
 LAYOUTS = ("per_trial", "per_run")
 ELITISM = ("species", "ratchet")
+WEIGHTS = ("neat", "encog")
 OBJECTIVES = ("task", "morphology", "controller")
 
 
@@ -83,7 +86,7 @@ def _species_modes() -> tuple[str, ...]:
 #: Keys whose value is one of a few names.
 CHOICES = {"method": lambda: METHODS, "speciation": _species_modes, "protocol": lambda: PROTOCOLS,
            "layout": lambda: LAYOUTS, "elitism": lambda: ELITISM, "complexity": lambda: COMPLEXITY_FORMULAS,
-           "truncation": lambda: TRUNCATIONS}
+           "truncation": lambda: TRUNCATIONS, "weights": lambda: WEIGHTS}
 
 
 class ExperimentError(ValueError):
@@ -109,6 +112,7 @@ class Experiment:
     elitism: str = "species"
     complexity: str = "paper"
     truncation: str = "neat"  # evolution.reproduction.breeding.truncate
+    weights: str = "neat"  # "encog": evolution.reproduction.encog.use_encog_weights
     neat_config: Path = field(default_factory=lambda: CONFIG_DIR / DEFAULT_NEAT_CONFIGS["hyperneat-m"])
     environment: dict[str, Any] = field(default_factory=lambda: {"environment": 2, "max_cycles": 10_000})
     substrate: dict[str, Any] = field(default_factory=dict)

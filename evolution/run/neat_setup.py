@@ -58,6 +58,10 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
         config.reproduction_config.ratchet = experiment.elitism == "ratchet"
     config.pop_size = experiment.population
     config.genome_config.truncation = experiment.truncation  # read by breeding.breed, both arms
+    if experiment.weights == "encog":
+        from evolution.reproduction.encog import use_encog_weights
+
+        use_encog_weights(config.genome_config, experiment.method)
     species = config.species_set_config
     if experiment.speciation is not None:
         species.species_mode = experiment.speciation

@@ -19,6 +19,9 @@ key                           paper (default)     original
 ``[experiment] truncation``   ``"neat"``          ``"encog"``: Encog's truncation, the best
                                                   max(floor(0.3 n), 1) of a species breed
                                                   (``evolution.reproduction.breeding``)
+``[experiment] weights``      ``"neat"``          ``"encog"``: link weights uniform in +-5 and
+                                                  Encog's weight operations
+                                                  (``evolution.reproduction.encog``)
 ``[experiment] speciation``   (the neat config's  ``"original"``: Encog's distance and threshold
                               ``species_mode``)   rule (``evolution.reproduction.species``); in SO
                                                   also Encog's species of leaders, offspring
@@ -61,10 +64,12 @@ newest one whose keys it holds with the same values (``saved_version``). The ori
    in place of version 2's velocity-drive keys, and its MASON schedule (``schedule =
    "shuffled"``): with these the scripted pushing scenes match the original's own classes, and
    the run's trials share its layout and differ by schedule, as the original's five did.
-4. (2026-12, the newest) adds Encog's truncation (``truncation = "encog"``): the 2018 code's
-   ``TruncationSelection(0.3)`` keeps max(floor(0.3 n), 1) of a species as parents where the
-   earlier versions kept ceil(0.3 n) and at least two, so in the original a species of fewer
-   than 7 genomes breeds from its best genome alone, by mutation.
+4. (2026-12, the newest) adds Encog's breeding as the 2018 code configured it: its truncation
+   (``truncation = "encog"``: ``TruncationSelection(0.3)`` keeps max(floor(0.3 n), 1) of a
+   species as parents where the earlier versions kept ceil(0.3 n) and at least two, so a
+   species of fewer than 7 genomes breeds from its best genome alone, by mutation) and its link
+   weights (``weights = "encog"``: uniform in +-5 where the earlier versions drew N(0, 1) clamped
+   to +-3; perturbations of deviation 0.02 or 1 (NEAT-M 0.004 or 0.2) where they used 0.5).
 
 ``protocol = "paper"`` names the defaults (one version). A file that names a protocol and sets
 one of its keys to another value is refused (``ExperimentError`` naming the file and key);
@@ -91,8 +96,9 @@ ORIGINAL_FORCE_DRIVE = {"drive_model": "force", "damping": 0.1}
 #: The original's MASON schedule, on top of the force drive (``gathering_env.drive.shuffled_times``).
 ORIGINAL_SCHEDULE = {"schedule": "shuffled"}
 
-#: Encog's truncation selection (version 4; ``evolution.reproduction.breeding.truncate``).
-ORIGINAL_TRUNCATION = {"truncation": "encog"}
+#: Encog's breeding as the 2018 code set it up (version 4): its truncation selection
+#: (``evolution.reproduction.breeding.truncate``) and link weights (``evolution.reproduction.encog``).
+ORIGINAL_BREEDING = {"truncation": "encog", "weights": "encog"}
 
 #: Protocol name -> version -> {section: {key: value}}; the "paper" values are the defaults of
 #: the dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``), filled in
@@ -105,7 +111,7 @@ BUNDLES: dict[str, dict[int, dict[str, dict[str, Any]]]] = {
         3: {"experiment": _METHOD, "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE,
                                                    **ORIGINAL_SCHEDULE},
             "substrate": _SUBSTRATE},
-        4: {"experiment": {**_METHOD, **ORIGINAL_TRUNCATION},
+        4: {"experiment": {**_METHOD, **ORIGINAL_BREEDING},
             "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE},
             "substrate": _SUBSTRATE},
     },
@@ -125,7 +131,7 @@ ORIGINAL_PHYSICS = (*_CONTACTS, *ORIGINAL_VELOCITY_DRIVE)
 DESCRIPTIONS = {
     "paper": "the paper's text (the defaults)",
     "original": "the 2018 Java code that produced the published figures: one layout per run, ratchet on the best "
-                "genome, Encog's truncation, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its eq. 2, its "
+                "genome, Encog's truncation and link weights, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its eq. 2, its "
                 "physics (mass friction, bouncing contacts) and its robot on its shuffled schedule",
 }
 
@@ -217,7 +223,6 @@ def apply_protocol(name: str, sections: dict[str, dict[str, Any]], source: str,
                 target[key] = list(value) if isinstance(value, list) else value
 
 
-__all__ = ["BUNDLES", "DESCRIPTIONS", "ORIGINAL", "ORIGINAL_FORCE_DRIVE", "ORIGINAL_PHYSICS", "ORIGINAL_SCHEDULE",
-           "ORIGINAL_TRUNCATION",
+__all__ = ["BUNDLES", "DESCRIPTIONS", "ORIGINAL", "ORIGINAL_BREEDING", "ORIGINAL_FORCE_DRIVE", "ORIGINAL_PHYSICS", "ORIGINAL_SCHEDULE",
            "ORIGINAL_VELOCITY_DRIVE", "PROTOCOLS", "apply_protocol", "newest_version", "protocol_values", "saved_version",
            "versions"]
