@@ -210,11 +210,21 @@ def experiment_from_run(saved: dict[str, Any], source: str, overrides: dict[str,
     return _validate(raw, source, CONFIG_DIR, overrides, need_neat_config=False, saved=True)
 
 
+#: ``[experiment]`` keys added after runs were first recorded: a saved experiment without one
+#: was run with its default (``with_protocol_version`` fills it in).
+LATER_KEYS = ("truncation", "weights")
+
+
 def with_protocol_version(saved: dict[str, Any]) -> dict[str, Any]:
-    """A saved experiment (``Experiment.to_dict()`` form) with its ``protocol_version``: one saved
-    before protocols had versions names a protocol but no version, and gets the version whose
-    keys it holds (``evolution.run.protocol.saved_version``). Anything else is returned as is."""
-    if not isinstance(saved, dict) or saved.get("protocol") not in PROTOCOLS or saved.get("protocol_version") is not None:
+    """A saved experiment (``Experiment.to_dict()`` form) with its ``protocol_version`` and every
+    key of ``LATER_KEYS``: one saved before protocols had versions names a protocol but no version,
+    and gets the version whose keys it holds (``evolution.run.protocol.saved_version``); one saved
+    before a later key existed gets that key's default, with which it ran."""
+    if not isinstance(saved, dict):
+        return saved
+    defaults = {f.name: f.default for f in fields(Experiment) if f.name in LATER_KEYS}
+    saved = {**{k: v for k, v in defaults.items() if k not in saved}, **saved}
+    if saved.get("protocol") not in PROTOCOLS or saved.get("protocol_version") is not None:
         return saved
     sections = {"experiment": saved, "environment": saved.get("environment") or {},
                 "substrate": saved.get("substrate") or {}}
