@@ -21,7 +21,7 @@ checks that the list and the pictures in docs/ are the same). The steps:
   ``--original-runs DIR`` holding ``S1-original-continued`` and ``M1-original`` rebuilt from their
   records (docs/evidence/original-M1/README.md); ``original-m1-five-analysis`` the same for
   version 3 (``S1-original-five`` and ``M1-original-five``, docs/evidence/original-M1-five/);
-* ``original-s1-continued``, ``original-s1-five``, ``original-s1-five-seed2``, ``original-m1-five``
+* ``original-s1-continued``, ``original-s1-five``, ``original-s1-five-seed2``, ``original-s1-v4``, ``original-m1-five``
   and the other steps of ``RECORD_CURVES`` (docs/evidence/<folder>/stats.png): the curve of a run
   kept going across sessions, drawn from its committed record (stats.jsonl);
 * ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
@@ -148,6 +148,7 @@ RECORD_CURVES = {
     "original-s1-five": ("original-S1-five", "S1-original (version 3), five schedules a genome"),
     "original-s1-five-seed2": ("original-S1-five-seed2", "S1-original (version 3), five schedules, seed 2"),
     "original-m1-five": ("original-M1-five", "M1-original (version 3), five schedules a genome"),
+    "original-s1-v4": ("original-S1-v4", "S1-original (version 4: Encog's truncation and weights)"),
 }
 
 
