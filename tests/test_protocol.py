@@ -77,6 +77,12 @@ def test_the_protocol_sets_every_original_option(tmp_path):
     ('protocol = "paper"\nelitism = "ratchet"',
      "[experiment] elitism = 'ratchet' contradicts protocol = 'paper'; allowed: 'species'"),
     ('layout = "everywhere"', "[experiment] layout='everywhere'; allowed: ['per_trial', 'per_run']"),
+    ('truncation = "floor"', "[experiment] truncation='floor'; allowed: ['neat', 'encog']"),
+    ("weights = 5", "[experiment] weights=5; allowed: ['neat', 'encog']"),
+    ('protocol = "original"\nweights = "neat"',
+     "[experiment] weights = 'neat' contradicts protocol = 'original'; allowed: 'encog'"),
+    ('protocol = "original"\nprotocol_version = 4\ntruncation = "neat"',
+     "[experiment] truncation = 'neat' contradicts protocol = 'original'; allowed: 'encog'"),
 ])
 def test_unknown_or_contradicting_options_name_the_file_and_key(tmp_path, capsys, body, needle):
     path = experiment(tmp_path, body=body)
