@@ -16,7 +16,7 @@ Layout (every key optional except where noted; defaults are the paper's, docs/mo
                                  # ("adaptive" | "original" | "fixed", evolution.reproduction.species)
     neat_config = "hyperneat_m.neat.cfg"   # neat-python config (see "neat_config" below)
     protocol = "original"        # a named bundle of the options below (evolution.run.protocol)
-    protocol_version = 3         # optional: which version of the bundle (default: the newest;
+    protocol_version = 4         # optional: which version of the bundle (default: the newest;
                                  # experiment.json records it, evolution.run.protocol)
     layout = "per_trial"         # "per_trial": fresh layouts from (seed, generation, trial);
                                  # "per_run": one layout for the whole run (the original code)
