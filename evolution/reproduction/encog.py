@@ -37,6 +37,8 @@ ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM = 16, 0
 #: for HyperNEAT-M's CPPN and NEAT-M's network alike): initial, added and reset weights are uniform
 #: in [-5, 5], and a perturbed weight is clamped to it.
 ENCOG_WEIGHT_RANGE = 5.0
+#: ``[experiment] weights``: the neat config's weight keys, or the original's (``use_encog_weights``).
+WEIGHT_SCHEMES = ("neat", "encog")
 #: The Gaussian deviations of the original's weight perturbation, small and large, per method
 #: (``HyperNEATMUtil``: 0.02 and 1; ``NEATMUtil``: 0.004 and 0.2).
 ENCOG_PERTURB_SIGMAS = {"hyperneat-m": (0.02, 1.0), "neat-m": (0.004, 0.2)}

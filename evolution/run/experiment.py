@@ -56,6 +56,7 @@ from pathlib import Path
 from typing import Any
 
 from evolution.reproduction.breeding import TRUNCATIONS
+from evolution.reproduction.encog import WEIGHT_SCHEMES
 from evolution.run.presets import CONFIG_DIR, DEFAULT_NEAT_CONFIGS
 from evolution.run.protocol import PROTOCOLS, apply_protocol, newest_version, saved_version, versions
 from gathering_env.config import WorldConfig
@@ -65,7 +66,6 @@ from gathering_env.world import GatheringWorld
 METHODS = ("hyperneat-m", "neat-m")
 LAYOUTS = ("per_trial", "per_run")
 ELITISM = ("species", "ratchet")
-WEIGHTS = ("neat", "encog")
 OBJECTIVES = ("task", "morphology", "controller")
 
 
@@ -86,7 +86,7 @@ def _species_modes() -> tuple[str, ...]:
 #: Keys whose value is one of a few names.
 CHOICES = {"method": lambda: METHODS, "speciation": _species_modes, "protocol": lambda: PROTOCOLS,
            "layout": lambda: LAYOUTS, "elitism": lambda: ELITISM, "complexity": lambda: COMPLEXITY_FORMULAS,
-           "truncation": lambda: TRUNCATIONS, "weights": lambda: WEIGHTS}
+           "truncation": lambda: TRUNCATIONS, "weights": lambda: WEIGHT_SCHEMES}
 
 
 class ExperimentError(ValueError):

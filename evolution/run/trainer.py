@@ -82,8 +82,11 @@ def protocol_notes(exp: Experiment) -> list[str]:
         notes.append(f"{exp.name}: Encog's truncation (truncation = encog): the best max(floor(f n), 1) genomes of a "
                      "species of n breed (f = parent_fraction; at 0.3 a species of fewer than 7 breeds from its best alone)")
     if exp.weights == "encog":
-        notes.append(f"{exp.name}: Encog's link weights (weights = encog): uniform in +-5, perturbed by a deviation of "
-                     "0.02 or 1 (NEAT-M 0.004 or 0.2) or reset (evolution.reproduction.encog)")
+        from evolution.reproduction.encog import ENCOG_PERTURB_SIGMAS, ENCOG_WEIGHT_RANGE
+
+        small, large = ENCOG_PERTURB_SIGMAS[exp.method]
+        notes.append(f"{exp.name}: Encog's link weights (weights = encog): uniform in +-{ENCOG_WEIGHT_RANGE:g}, perturbed "
+                     f"by a deviation of {small:g} or {large:g}, or reset (evolution.reproduction.encog)")
     return notes
 
 
