@@ -21,11 +21,14 @@ speciation, by ``species_mode`` in its config section ``[GatheringSpeciesSet]``:
   the distance is ``E + D + 0.4 * mean |dw|`` over connection genes aligned by innovation
   number, on raw weights, not normalised by size (``original_distance``), plus for genomes with
   sensor genes (NEAT-M) their sensor term; before genomes are assigned, the threshold moves by
-  ``threshold_step`` (0.01, additive): up when the previous generation had more than
-  ``max_species`` species (40 in SO, the population in MO), down when fewer than
-  ``min_species`` (2); it starts at ``compatibility_threshold`` (1.0) and has no floor (below 0
-  every genome but the leaders founds a species, so the count jumps and the threshold climbs
-  back; ``threshold_min`` is the adaptive rule's). In single-objective runs
+  ``threshold_step`` (0.01, additive): up when more than ``max_species`` species (40 in SO,
+  the population in MO) survived from the previous generation, down when fewer than
+  ``min_species`` (2) did; it starts at ``compatibility_threshold`` (1.0) and has no floor (below 0
+  every genome but the leaders founds a species; ``threshold_min`` is the adaptive rule's). The
+  count that moves it is of the species that *survived*: with the ratchet and elite rate 0 (the
+  2018 SO set-up) only the best genome's species does, so the threshold falls by 0.01 every
+  generation, below 0 from generation 100, and from then on every genome is its own species,
+  as in the original. In single-objective runs
   species are also Encog's (``leaders``, set by ``use_original_rule``): generation 0 is one
   species; a species is represented by its *leader* (its best genome, which
   ``NEATReproduction`` names after each evaluation; on a tie the leader keeps its place) and
