@@ -815,6 +815,22 @@ def test_a_one_layout_run_says_how_its_trials_are_run():
     assert "one trial on it with one shuffled schedule" in lines["one"]
 
 
+def test_the_encog_weights_note_gives_each_methods_own_deviations():
+    """The run's start note reads the range and the small and large deviations of the method it runs
+    (HyperNEAT-M 0.02 or 1, NEAT-M 0.004 or 0.2, by hand from the 2018 HyperNEATMUtil/NEATMUtil), in order."""
+    from dataclasses import replace
+
+    from evolution.run.trainer import protocol_notes
+
+    path, overrides = resolve_preset("S1-original")
+    exp = load_experiment(path, overrides)
+    note = {m: next(n for n in protocol_notes(replace(exp, method=m)) if "weights = encog" in n)
+            for m in ("hyperneat-m", "neat-m")}
+    assert "uniform in +-5, perturbed by a deviation of 0.02 or 1, or reset" in note["hyperneat-m"]
+    assert "uniform in +-5, perturbed by a deviation of 0.004 or 0.2, or reset" in note["neat-m"]
+    assert not any("weights = encog" in n for n in protocol_notes(replace(exp, weights="neat")))
+
+
 def test_a_one_layout_run_refuses_a_layout_seed_of_its_own(tmp_path):
     path = experiment(tmp_path, body='layout = "per_run"')
     path.write_text(path.read_text() + "layout_seed = 4\n")

@@ -31,6 +31,7 @@ from typing import Any
 import neat
 
 from evolution.guard import UsageError, describe_os_error, writing
+from evolution.reproduction.encog import ENCOG_PERTURB_SIGMAS, ENCOG_WEIGHT_RANGE
 from evolution.run.backends import EvalContext, make_evaluator
 from evolution.run.evaluate import Evaluation, training_environment, varied_episodes
 from evolution.run.experiment import Experiment
@@ -82,8 +83,6 @@ def protocol_notes(exp: Experiment) -> list[str]:
         notes.append(f"{exp.name}: Encog's truncation (truncation = encog): the best max(floor(f n), 1) genomes of a "
                      "species of n breed (f = parent_fraction; at 0.3 a species of fewer than 7 breeds from its best alone)")
     if exp.weights == "encog":
-        from evolution.reproduction.encog import ENCOG_PERTURB_SIGMAS, ENCOG_WEIGHT_RANGE
-
         small, large = ENCOG_PERTURB_SIGMAS[exp.method]
         notes.append(f"{exp.name}: Encog's link weights (weights = encog): uniform in +-{ENCOG_WEIGHT_RANGE:g}, perturbed "
                      f"by a deviation of {small:g} or {large:g}, or reset (evolution.reproduction.encog)")
