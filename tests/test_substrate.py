@@ -124,6 +124,26 @@ def test_bottom_sensor_on_node_zero(config):
     assert [s.type for s in morph] == ["bottom"] and controller.num_links == 0
 
 
+def test_an_unlinked_node_zero_keeps_every_sensor_on_its_own_links(config):
+    # weight = 0.5 * y1: node 0 (y1 = 0) gets no link, yet carries the bottom sensor; every other
+    # node's sensor reads into that node's own links. (The original's decoder numbered inputs by
+    # first link, so there every reading fed the next node's links: not copied, docs/fidelity.md.)
+    genome = cppn(config, {(Y1, WEIGHT): 0.5})
+    controller, morph = decode(genome, config, Substrate(bottom_on_node0=True))
+    y1 = 1.5 * np.sin(0.65 * np.arange(10))
+    w = 0.5 * y1
+    linked = np.flatnonzero(np.abs(w) > 0.2)
+    assert 0 not in linked and len(linked) == 8      # nodes 1-4 and 6-9 (node 5: |w| = 0.08)
+    assert morph[0].type == "bottom" and len(morph) == 1 + len(linked)
+    expected = np.sign(w[linked]) * (np.abs(w[linked]) - 0.2) * 5.0 / 0.8
+    weights = controller.layers[0].weights
+    np.testing.assert_allclose(weights[:, 0], [0.0, 0.0])              # the bottom reading: no links
+    np.testing.assert_allclose(weights[0, 1:], expected)               # column k: node linked[k - 1]
+    np.testing.assert_allclose(weights[1, 1:], expected)
+    np.testing.assert_allclose([s.bearing for s in morph[1:]],
+                               [math.atan2(y1[i], 1.5 * math.cos(0.65 * i)) for i in linked])
+
+
 def test_decoded_morphology_drives_the_env(config):
     genome = cppn(config, {(X1, WEIGHT): 0.3, (Y1, TYPE): 0.5}, biases={BIAS: 0.5})
     controller, morph = decode(genome, config)
