@@ -24,6 +24,8 @@ checks that the list and the pictures in docs/ are the same). The steps:
 * ``original-s1-continued``, ``original-s1-five``, ``original-s1-five-seed2``, ``original-s1-v4``, ``original-m1-five``
   and the other steps of ``RECORD_CURVES`` (docs/evidence/<folder>/stats.png): the curve of a run
   kept going across sessions, drawn from its committed record (stats.jsonl);
+* ``original-s1-v4-cells`` (docs/evidence/original-S1-v4/cells.png): best-ever ft of version 4's
+  2 x 2 (Encog's truncation, Encog's weights, both, neither) from the committed records;
 * ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
   docs/rl/README.md; needs ``--rl DIR`` (the runs) and the demo champion.
 
@@ -167,6 +169,43 @@ def record_curve(step: str) -> Callable[[argparse.Namespace], None]:
     return make
 
 
+# docs/evidence folder -> label: version 4's 2 x 2 of Encog's truncation and weights (seed 1), with
+# version 3's second seed for scale; drawn from the committed records
+V4_CELLS = {
+    "original-S1-five": ("version 3 (neither), seed 1", "C0", "-"),
+    "original-S1-five-seed2": ("version 3 (neither), seed 2", "C0", "--"),
+    "original-S1-v4-neat-weights": ("Encog's truncation only", "C2", "-"),
+    "original-S1-v4-neat-truncation": ("Encog's weights only", "C1", "-"),
+    "original-S1-v4": ("version 4 (both), seed 1", "C3", "-"),
+}
+
+
+def make_v4_cells(args: argparse.Namespace) -> None:
+    """Best-ever ft by generation of version 4's 2 x 2 (``docs/evidence/original-S1-v4/cells.png``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from evolution.run.stats import read_stats
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for folder, (label, colour, style) in V4_CELLS.items():
+        path = DOCS / "evidence" / folder / "stats.jsonl"
+        if not path.exists():
+            continue
+        rows = read_stats(path)
+        ax.plot([r["generation"] for r in rows], [r["task_best"] for r in rows], style, color=colour, label=label)
+    ax.axhline(110, color="grey", lw=0.8, ls=":", label="convergence (110)")
+    ax.set_xlabel("generation")
+    ax.set_ylabel("best-ever ft (mean of 5 schedules)")
+    ax.set_title("S1-original: Encog's truncation and link weights, one at a time")
+    ax.legend(loc="lower right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(DOCS / "evidence" / "original-S1-v4" / "cells.png", dpi=110)
+    plt.close(fig)
+
+
 ORIGINAL_M1_ANALYSES = {"analysis-training": "0", "analysis-heldout": "20"}  # folder -> --reevaluate
 # step -> (S1 run, M1 run, docs/evidence folder): the M1 run beside the S1 run of its protocol version
 ORIGINAL_M1_PAIRS = {
@@ -226,6 +265,7 @@ STEPS: dict[str, Step] = {
     "rl": Step(tuple(f"rl/{f}" for f in (*RL_FIGURES, *RL_CURVES)), "rl", make_rl),
     "marl": Step(("rl/curves-marl-env1.png",), "marl", make_marl),
     "original-s1": Step(("evidence/original-S1/stats.png",), "original_s1", make_original_s1),
+    "original-s1-v4-cells": Step(("evidence/original-S1-v4/cells.png",), None, make_v4_cells),
     **{step: Step((f"evidence/{folder}/stats.png",), None, record_curve(step))
        for step, (folder, _) in RECORD_CURVES.items()},
     **{step: Step(tuple(f"evidence/{target}/{folder}/{f}" for folder in ORIGINAL_M1_ANALYSES
