@@ -38,7 +38,7 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
 from evolution.analysis.fronts import selection_points  # noqa: E402
 from evolution.analysis.reevaluate import heldout_seeds  # noqa: E402
-from evolution.compare import run_episode  # noqa: E402
+from evolution.compare import paired_difference, run_episode  # noqa: E402
 from evolution.policies import make_policy  # noqa: E402
 from evolution.run.champion import champion_objectives, read_json  # noqa: E402
 from evolution.run.experiment import load_experiment  # noqa: E402
@@ -105,20 +105,14 @@ def heldout_scores(policies: dict[str, str], args: argparse.Namespace, seeds: li
 
 
 def paired(scores: dict[str, list[float]], baseline: str = "wander") -> list[dict]:
-    from scipy.stats import wilcoxon
-
     base = np.array(scores[baseline])
     rows = []
     for label, values in scores.items():
         v = np.array(values)
-        diff = v - base
-        p = float("nan")
-        if label != baseline and np.any(diff != 0):
-            p = float(wilcoxon(v, base).pvalue)
+        d = paired_difference(v, base)
         rows.append({"policy": label, "mean": float(v.mean()), "se": float(v.std(ddof=1) / np.sqrt(len(v))),
                      "ratio_to_wander": float(v.mean() / base.mean()) if base.mean() else float("nan"),
-                     "diff_to_wander": float(diff.mean()), "diff_se": float(diff.std(ddof=1) / np.sqrt(len(v))),
-                     "wilcoxon_p": p})
+                     "diff_to_wander": d["diff"], "diff_se": d["diff_se"], "wilcoxon_p": d["wilcoxon_p"]})
     return rows
 
 

@@ -3,7 +3,11 @@
 ``gathering-compare --policy random --policy heuristic --policy wander --policy champion:run/champion.json
 --policy ppo:ppo/model.zip --environment 2 --episodes 5 --out compare/`` runs every policy on
 the same environment and episode seeds and writes ``compare.md`` / ``compare.csv`` (mean ± standard error of
-ft, blocks gathered by type, time to finish) and ``compare.png`` (a bar plot).
+ft, blocks gathered by type, time to finish), ``episodes.csv`` (one row per policy and seed) and
+``compare.png`` (a bar plot). Since every policy meets the same seeds, ``compare.md`` also pairs
+each policy with the first one named: the mean per-seed difference of ft ± its standard error,
+how many seeds it scored higher, equal and lower, and the two-sided Wilcoxon signed-rank p
+(scipy's ``wilcoxon``; zero differences dropped).
 
 ``--protocol original`` runs them in the original protocol's world (``evolution.run.protocol``:
 zone 20 x 4, the pickup box at the robot's centre, the Khepera-like IR curve), where a champion of
@@ -57,7 +61,8 @@ def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
 def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]) -> list[dict[str, Any]]:
     """One row per policy: ft's mean, standard deviation (``ft_std``, ddof 0) and standard error
     of the mean (``ft_se`` = sample std / sqrt(episodes), None for one episode), mean blocks by
-    type, mean steps to finish, finished count."""
+    type, mean steps to finish, finished count; and under ``PER_EPISODE`` its episodes, one dict
+    per seed in ``seeds`` order."""
     env = parallel_env(**env_config)
     rows = []
     seen: dict[str, int] = {}
@@ -74,6 +79,10 @@ def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]
             "small": float(by_type[:, 0].mean()), "medium": float(by_type[:, 1].mean()),
             "large": float(by_type[:, 2].mean()),
             "finished": len(done), "steps_to_finish": float(np.mean(done)) if done else None,
+            PER_EPISODE: [{"policy": name, "seed": s, "ft": float(e["ft"]), "small": int(e["by_type"][0]),
+                           "medium": int(e["by_type"][1]), "large": int(e["by_type"][2]),
+                           "finished": bool(e["finished"]), "steps": int(e["steps"])}
+                          for s, e in zip(seeds, episodes)],
         })
     return rows
 
@@ -99,9 +108,43 @@ def standard_error(sample: np.ndarray) -> float | None:
     return float(sample.std(ddof=1) / np.sqrt(len(sample))) if len(sample) > 1 else None
 
 
+def paired_difference(values: Any, baseline: Any) -> dict[str, Any]:
+    """``values`` against ``baseline``, episode by episode (the same seeds in the same order):
+    mean and standard error of the differences, how many are > 0, = 0, < 0, and the two-sided
+    Wilcoxon signed-rank p (scipy; zero differences dropped; NaN when every difference is 0)."""
+    from scipy.stats import wilcoxon
+
+    v, base = np.asarray(values, dtype=float), np.asarray(baseline, dtype=float)
+    if v.shape != base.shape or v.ndim != 1 or len(v) == 0:
+        raise ValueError(f"paired samples need the same episodes; got {v.shape} and {base.shape}")
+    diff = v - base
+    return {"diff": float(diff.mean()), "diff_se": standard_error(diff),
+            "higher": int(np.sum(diff > 0)), "equal": int(np.sum(diff == 0)), "lower": int(np.sum(diff < 0)),
+            "wilcoxon_p": float(wilcoxon(v, base).pvalue) if np.any(diff != 0) else float("nan")}
+
+
+def paired_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """The paired table of ``compare.md``: every policy after the first against the first."""
+    if len(rows) < 2 or any(PER_EPISODE not in r for r in rows) or rows[0]["episodes"] < 2:
+        return []
+    first = rows[0]
+    base = [e["ft"] for e in first[PER_EPISODE]]
+    lines = ["", f"Paired with {first['policy']} on the same seeds (difference = policy − {first['policy']}):", "",
+             "| policy | ft difference (mean ± standard error) | seeds higher / equal / lower | Wilcoxon signed-rank p |",
+             "|---|---|---|---|"]
+    for r in rows[1:]:
+        d = paired_difference([e["ft"] for e in r[PER_EPISODE]], base)
+        p = "—" if np.isnan(d["wilcoxon_p"]) else f"{d['wilcoxon_p']:.2g}"
+        lines.append(f"| {r['policy']} | {d['diff']:+.2f} ± {d['diff_se']:.2f} | "
+                     f"{d['higher']} / {d['equal']} / {d['lower']} | {p} |")
+    return lines
+
+
 #: Every file ``write_outputs`` writes: the output folder may hold these (an earlier
 #: comparison, replaced) and nothing else.
-COMPARE_FILES = ("compare.csv", "compare.md", "compare.png")
+COMPARE_FILES = ("compare.csv", "compare.md", "compare.png", "episodes.csv")
+#: The key of a ``compare`` row that holds its episodes (written to episodes.csv, not compare.csv).
+PER_EPISODE = "per_episode"
 
 
 def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Path, Path, Path]:
@@ -113,10 +156,18 @@ def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Pa
     check_output_dir(out, (*COMPARE_FILES, LOCK_FILE))
     out.mkdir(parents=True, exist_ok=True)
     csv_path = out / "compare.csv"
+    summary = [{k: v for k, v in r.items() if k != PER_EPISODE} for r in rows]
     with writing(csv_path), open(csv_path, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer = csv.DictWriter(f, fieldnames=list(summary[0]))
         writer.writeheader()
-        writer.writerows(rows)
+        writer.writerows(summary)
+    episodes = [e for r in rows for e in r.get(PER_EPISODE, [])]
+    if episodes:
+        episodes_path = out / "episodes.csv"
+        with writing(episodes_path), open(episodes_path, "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=list(episodes[0]))
+            writer.writeheader()
+            writer.writerows(episodes)
     lines = ["| policy | sensors | ft (mean ± standard error) | small | medium | large | finished | steps to finish |",
              "|---|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -126,7 +177,7 @@ def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Pa
                      f"{r['medium']:.1f} | {r['large']:.1f} | {r['finished']}/{r['episodes']} | {steps} |")
     md_path = out / "compare.md"
     with writing(md_path):
-        md_path.write_text(f"{title}\n\n" + "\n".join(lines) + "\n")
+        md_path.write_text(f"{title}\n\n" + "\n".join(lines + paired_lines(rows)) + "\n")
     fig, ax = plt.subplots(figsize=(1.6 + 1.3 * len(rows), 3.6), constrained_layout=True)
     ax.bar(range(len(rows)), [r["ft_mean"] for r in rows], yerr=[r["ft_se"] or 0.0 for r in rows], capsize=4,
            color="tab:blue")
@@ -163,7 +214,7 @@ def compare_main(argv: list[str] | None = None) -> int:
                         help="with --world-from a one-layout run's champion under the shuffled schedule: keep "
                              "its layout (layout_seed); the episodes' seeds then vary only the schedule")
     parser.add_argument("--out", type=Path, default=Path("compare"),
-                        help="folder for compare.md, compare.csv, compare.png (default compare/)")
+                        help="folder for compare.md, compare.csv, episodes.csv, compare.png (default compare/)")
     args = parser.parse_args(argv)
     if args.world_from is not None and args.protocol is not None:
         raise UsageError("--world-from and --protocol both name the world; allowed: one of them")
@@ -198,7 +249,8 @@ def compare_main(argv: list[str] | None = None) -> int:
         rows = compare(policies, env_config, list(range(args.seed, args.seed + args.episodes)))
         md, csv_path, png = write_outputs(rows, args.out, title)
     print(md.read_text())
-    print(f"wrote {md}, {csv_path}, {png}")
+    written = [md, csv_path, *([args.out / "episodes.csv"] if (args.out / "episodes.csv").exists() else []), png]
+    print("wrote " + ", ".join(map(str, written)))
     return 0
 
 
