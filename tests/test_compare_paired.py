@@ -106,3 +106,12 @@ def test_compare_keeps_each_episode_in_seed_order(tmp_path, capsys):
         ["compare.csv", "compare.md", "compare.png", "episodes.csv"]
     assert "Paired with wander" in (out / "compare.md").read_text()
     assert "episodes.csv" in capsys.readouterr().out
+
+
+def test_two_champions_of_one_run_keep_their_file_names():
+    from evolution.policies.evolved import champion_name
+
+    assert champion_name("runs/S1/champion.json") == "champion:S1"
+    assert champion_name("docs/evidence/original-S1-v4/champion-gen55.json") == "champion:original-S1-v4/champion-gen55"
+    assert champion_name("champion-gen10.json") == "champion:champion-gen10"
+    assert champion_name("champion.json") == "champion:champion.json"
