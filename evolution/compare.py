@@ -3,7 +3,7 @@
 ``gathering-compare --policy random --policy heuristic --policy wander --policy champion:run/champion.json
 --policy ppo:ppo/model.zip --environment 2 --episodes 5 --out compare/`` runs every policy on
 the same environment and episode seeds and writes ``compare.md`` / ``compare.csv`` (mean ± standard error of
-ft, blocks gathered by type, time to finish), ``episodes.csv`` (one row per policy and seed) and
+ft, blocks gathered by type, time to finish), ``compare-episodes.csv`` (one row per policy and seed) and
 ``compare.png`` (a bar plot). Since every policy meets the same seeds, ``compare.md`` also pairs
 each policy with the first one named: the mean per-seed difference of ft ± its standard error,
 how many seeds it scored higher, equal and lower, and the two-sided Wilcoxon signed-rank p
@@ -142,8 +142,8 @@ def paired_lines(rows: list[dict[str, Any]]) -> list[str]:
 
 #: Every file ``write_outputs`` writes: the output folder may hold these (an earlier
 #: comparison, replaced) and nothing else.
-COMPARE_FILES = ("compare.csv", "compare.md", "compare.png", "episodes.csv")
-#: The key of a ``compare`` row that holds its episodes (written to episodes.csv, not compare.csv).
+COMPARE_FILES = ("compare.csv", "compare.md", "compare.png", "compare-episodes.csv")
+#: The key of a ``compare`` row that holds its episodes (written to compare-episodes.csv, not compare.csv).
 PER_EPISODE = "per_episode"
 
 
@@ -163,7 +163,7 @@ def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Pa
         writer.writerows(summary)
     episodes = [e for r in rows for e in r.get(PER_EPISODE, [])]
     if episodes:
-        episodes_path = out / "episodes.csv"
+        episodes_path = out / "compare-episodes.csv"
         with writing(episodes_path), open(episodes_path, "w", newline="") as f:
             writer = csv.DictWriter(f, fieldnames=list(episodes[0]))
             writer.writeheader()
@@ -214,7 +214,7 @@ def compare_main(argv: list[str] | None = None) -> int:
                         help="with --world-from a one-layout run's champion under the shuffled schedule: keep "
                              "its layout (layout_seed); the episodes' seeds then vary only the schedule")
     parser.add_argument("--out", type=Path, default=Path("compare"),
-                        help="folder for compare.md, compare.csv, episodes.csv, compare.png (default compare/)")
+                        help="folder for compare.md, compare.csv, compare-episodes.csv, compare.png (default compare/)")
     args = parser.parse_args(argv)
     if args.world_from is not None and args.protocol is not None:
         raise UsageError("--world-from and --protocol both name the world; allowed: one of them")
@@ -249,7 +249,8 @@ def compare_main(argv: list[str] | None = None) -> int:
         rows = compare(policies, env_config, list(range(args.seed, args.seed + args.episodes)))
         md, csv_path, png = write_outputs(rows, args.out, title)
     print(md.read_text())
-    written = [md, csv_path, *([args.out / "episodes.csv"] if (args.out / "episodes.csv").exists() else []), png]
+    episodes = args.out / "compare-episodes.csv"
+    written = [md, csv_path, *([episodes] if episodes.exists() else []), png]
     print("wrote " + ", ".join(map(str, written)))
     return 0
 

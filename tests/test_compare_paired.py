@@ -1,4 +1,4 @@
-"""gathering-compare pairs policies on their common seeds: per-episode scores (episodes.csv) and,
+"""gathering-compare pairs policies on their common seeds: per-episode scores (compare-episodes.csv) and,
 in compare.md, each policy against the first: mean difference ± standard error, seeds higher /
 equal / lower, and the Wilcoxon signed-rank p, checked against hand values and a brute-force
 sign-flip enumeration (the exact null distribution when no two |differences| tie)."""
@@ -78,7 +78,7 @@ def test_compare_md_pairs_every_policy_with_the_first_and_episodes_csv_keeps_eac
     assert "| random | -0.25 ± 0.25 | 0 / 3 / 1 |" in text          # one difference: -1
     with open(csv_path) as f:
         assert PER_EPISODE not in next(csv.reader(f))                  # the summary keeps its columns
-    with open(tmp_path / "out" / "episodes.csv") as f:
+    with open(tmp_path / "out" / "compare-episodes.csv") as f:
         episodes = list(csv.DictReader(f))
     assert [(e["policy"], int(e["seed"]), float(e["ft"])) for e in episodes[4:8]] == \
         [("champion", 0, 3.0), ("champion", 1, 5.0), ("champion", 2, 5.0), ("champion", 3, 9.0)]
@@ -103,9 +103,9 @@ def test_compare_keeps_each_episode_in_seed_order(tmp_path, capsys):
     assert compare_main(["--policy", "wander", "--policy", "random", "--environment", "1", "--robots", "4",
                          "--steps", "30", "--episodes", "3", "--out", str(out)]) == 0
     assert sorted(p.name for p in out.iterdir() if p.name != ".lock") == \
-        ["compare.csv", "compare.md", "compare.png", "episodes.csv"]
+        ["compare-episodes.csv", "compare.csv", "compare.md", "compare.png"]
     assert "Paired with wander" in (out / "compare.md").read_text()
-    assert "episodes.csv" in capsys.readouterr().out
+    assert "compare-episodes.csv" in capsys.readouterr().out
 
 
 def test_two_champions_of_one_run_keep_their_file_names():
