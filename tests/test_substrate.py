@@ -144,6 +144,25 @@ def test_an_unlinked_node_zero_keeps_every_sensor_on_its_own_links(config):
                                [math.atan2(y1[i], 1.5 * math.cos(0.65 * i)) for i in linked])
 
 
+def test_the_originals_atan_bearings_fold_every_sensor_to_the_front(config):
+    # bearings = "atan": the original's atan(y / x). Nodes at 0.65 i; those behind the body
+    # (cos < 0: i = 3..7) land at their angle minus pi, those past 3 pi / 2 (i = 8, 9) minus 2 pi.
+    genome = cppn(config, {(X1, WEIGHT): 0.1}, biases={WEIGHT: 0.9})       # every node linked
+    folded_controller, folded = decode(genome, config, Substrate(bottom_on_node0=False, bearings="atan"))
+    controller, plain = decode(genome, config, Substrate(bottom_on_node0=False))
+    by_hand = [0.0, 0.65, 1.3, 1.95 - math.pi, 2.6 - math.pi, 3.25 - math.pi, 3.9 - math.pi, 4.55 - math.pi,
+               5.2 - 2 * math.pi, 5.85 - 2 * math.pi]
+    np.testing.assert_allclose([s.bearing for s in folded], by_hand, atol=1e-12)
+    assert all(abs(s.bearing) < math.pi / 2 for s in folded)
+    assert [s.bearing for s in plain][5] == pytest.approx(3.25 - 2 * math.pi)   # atan2: behind the body
+    # only the bearings differ: same types, parameters and controller
+    assert [(s.type, s.range, s.fov, s.orientation) for s in folded] == \
+        [(s.type, s.range, s.fov, s.orientation) for s in plain]
+    np.testing.assert_array_equal(folded_controller.layers[0].weights, controller.layers[0].weights)
+    with pytest.raises(ValueError, match="bearings='atan3'; allowed: atan2, atan"):
+        Substrate(bearings="atan3")
+
+
 def test_decoded_morphology_drives_the_env(config):
     genome = cppn(config, {(X1, WEIGHT): 0.3, (Y1, TYPE): 0.5}, biases={BIAS: 0.5})
     controller, morph = decode(genome, config)

@@ -20,7 +20,9 @@ target); every output is clipped to [-1, 1]. Decoding:
   weight: type from the ``type`` output split into ``len(sensor_types)`` equal bands over
   [-1, 1] (infrared, ultrasonic, camera, colour: the original's order); fov and range mapped linearly from
   [-1, 1] onto the type's bounds (range onto [``range_floor`` * max, max] since 0 is
-  excluded), orientation onto [-pi/2, pi/2]; bearing = atan2(y, x) of the input node;
+  excluded), orientation onto [-pi/2, pi/2]; bearing = atan2(y, x) of the input node
+  (``bearings = "atan"``: the original's atan(y / x), which puts every sensor on the front half
+  of the body, a node behind it at its angle minus pi);
 * ``decode_window`` (default 1): the share of each interval (range, FOV, orientation) the
   outputs reach, centred on its middle; the original code reached only the middle 0.2 (its
   Encog ``NormalizedField`` mapped [-1, 1] as if from [-5, 5]);
@@ -68,6 +70,7 @@ class Substrate:
     hidden_activation: str = "tanh"
     bias_threshold: bool = False
     decode_window: float = 1.0
+    bearings: str = "atan2"
 
     def __post_init__(self) -> None:
         if not 1 <= self.num_inputs <= 10:
@@ -88,6 +91,8 @@ class Substrate:
             raise ValueError(f"substrate decode_window={self.decode_window}; allowed: (0, 1]")
         if not 0.0 < self.range_floor < 1.0:
             raise ValueError(f"substrate range_floor={self.range_floor}; allowed: (0, 1)")
+        if self.bearings not in BEARING_RULES:
+            raise ValueError(f"substrate bearings={self.bearings!r}; allowed: {', '.join(BEARING_RULES)}")
 
     def input_positions(self) -> np.ndarray:
         """(num_inputs, 2) input node coordinates."""
@@ -126,7 +131,15 @@ class Substrate:
         )
 
 
-def _bearing(x: float, y: float) -> float:
+BEARING_RULES = ("atan2", "atan")
+
+
+def _bearing(x: float, y: float, rule: str = "atan2") -> float:
+    """A sensor's bearing from its input node's position: ``atan2`` (all round the body, in
+    [-pi, pi)) or the original's ``atan`` of y / x, which folds every node into the front half,
+    (-pi/2, pi/2] (a node at angle theta behind the body lands at theta - pi)."""
+    if rule == "atan":
+        return math.atan(y / x) if x != 0.0 else math.copysign(math.pi / 2, y)
     b = math.atan2(y, x)
     return -math.pi if b >= math.pi else b
 
@@ -166,7 +179,7 @@ def decode(genome: Any, config: Any, substrate: Substrate | None = None) -> tupl
         if linked.size == 0:
             continue  # no link, no sensor
         strongest = linked[np.argmax(q_in[i, linked, W])]
-        sensors.append(sub.sensor_from_outputs(q_in[i, strongest], _bearing(x, y)))
+        sensors.append(sub.sensor_from_outputs(q_in[i, strongest], _bearing(x, y, sub.bearings)))
         used.append(i)
 
     s = len(used)
