@@ -25,7 +25,8 @@ checks that the list and the pictures in docs/ are the same). The steps:
   and the other steps of ``RECORD_CURVES`` (docs/evidence/<folder>/stats.png): the curve of a run
   kept going across sessions, drawn from its committed record (stats.jsonl);
 * ``original-s1-v4-cells`` (docs/evidence/original-S1-v4/cells.png): best-ever ft of version 4's
-  2 x 2 (Encog's truncation, Encog's weights, both, neither) from the committed records;
+  2 x 2 (Encog's truncation, Encog's weights, both, neither) and of version 4 with the original's
+  bearings, from the committed records;
 * ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
   docs/rl/README.md; needs ``--rl DIR`` (the runs) and the demo champion.
 
@@ -169,14 +170,16 @@ def record_curve(step: str) -> Callable[[argparse.Namespace], None]:
     return make
 
 
-# docs/evidence folder -> label: version 4's 2 x 2 of Encog's truncation and weights (seed 1), with
-# version 3's second seed for scale; drawn from the committed records
+# docs/evidence folder -> (label, colour, line style): version 4's 2 x 2 of Encog's truncation and
+# weights (seed 1), version 4 with the original's bearings, and version 3's second seed for
+# scale; drawn from the committed records
 V4_CELLS = {
     "original-S1-five": ("version 3 (neither), seed 1", "C0", "-"),
     "original-S1-five-seed2": ("version 3 (neither), seed 2", "C0", "--"),
     "original-S1-v4-neat-weights": ("Encog's truncation only", "C2", "-"),
     "original-S1-v4-neat-truncation": ("Encog's weights only", "C1", "-"),
     "original-S1-v4": ("version 4 (both), seed 1", "C3", "-"),
+    "original-S1-v4-atan-bearings": ("version 4 with the original's bearings", "C4", "-"),
 }
 
 
@@ -199,7 +202,7 @@ def make_v4_cells(args: argparse.Namespace) -> None:
     ax.axhline(110, color="grey", lw=0.8, ls=":", label="convergence (110)")
     ax.set_xlabel("generation")
     ax.set_ylabel("best-ever ft (mean of 5 schedules)")
-    ax.set_title("S1-original: Encog's truncation and link weights, one at a time")
+    ax.set_title("S1-original: version 4's options one at a time (seed 1)")
     ax.legend(loc="lower right", fontsize=8)
     fig.tight_layout()
     fig.savefig(DOCS / "evidence" / "original-S1-v4" / "cells.png", dpi=110)
