@@ -82,7 +82,9 @@ def test_the_protocol_sets_every_original_option(tmp_path):
     ('protocol = "original"\nweights = "neat"',
      "[experiment] weights = 'neat' contradicts protocol = 'original'; allowed: 'encog'"),
     ('protocol = "original"\nprotocol_version = 4\ntruncation = "neat"',
-     "[experiment] truncation = 'neat' contradicts protocol = 'original'; allowed: 'encog'"),
+     "[experiment] truncation = 'neat' contradicts protocol = 'original' (version 4); allowed: 'encog'"),
+    ('protocol = "original"\n[substrate]\nbearings = "atan2"',
+     "[substrate] bearings = 'atan2' contradicts protocol = 'original'; allowed: 'atan'"),
 ])
 def test_unknown_or_contradicting_options_name_the_file_and_key(tmp_path, capsys, body, needle):
     path = experiment(tmp_path, body=body)
@@ -155,16 +157,20 @@ def test_the_versions_of_the_original_bundle():
     v4 = protocol_values("original", 4)
     assert v4["environment"] == v3 and v4["substrate"] == protocol_values("original", 3)["substrate"]
     assert v4["experiment"] == protocol_values("original", 3)["experiment"] | {"truncation": "encog", "weights": "encog"}
-    assert protocol_values("original") == v4 and ORIGINAL["environment"] == v3
+    v5 = protocol_values("original", 5)
+    assert v5["environment"] == v3 and v5["experiment"] == v4["experiment"]
+    assert v5["substrate"] == v4["substrate"] | {"bearings": "atan"}
+    assert protocol_values("original") == v5 and ORIGINAL["environment"] == v3
     # "paper" names the defaults of every key any version sets
     paper = protocol_values("paper")["environment"]
     assert (paper["drive_model"], paper["damping"], paper["schedule"], paper["drive_dead_band"],
             paper["robot_max_speed"], paper["ground_friction"]) == ("velocity", 0.0, "fixed", 0.0, 0.5, "threshold")
     assert (protocol_values("paper")["experiment"]["truncation"], protocol_values("paper")["experiment"]["weights"]) \
         == ("neat", "neat")
+    assert protocol_values("paper")["substrate"]["bearings"] == "atan2"
 
 
-@pytest.mark.parametrize("version", [1, 2, 3, 4])
+@pytest.mark.parametrize("version", [1, 2, 3, 4, 5])
 def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path, version):
     exp = load_experiment(experiment(tmp_path, body=f'protocol = "original"\nprotocol_version = {version}'))
     saved = exp.to_dict()
@@ -174,6 +180,8 @@ def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path,
     assert again.protocol_version == version and again.environment == exp.environment
     assert again.truncation == exp.truncation == again.weights == ("encog" if version >= 4 else "neat")
     assert again.world_config() == exp.world_config()
+    assert again.substrate.get("bearings", "atan2") == exp.substrate.get("bearings", "atan2") == \
+        ("atan" if version >= 5 else "atan2")
 
 
 @pytest.mark.parametrize("folder, version", [("original-S1-2018", 1), ("original-S1-elite02", 1),
@@ -200,7 +208,7 @@ def test_the_five_schedule_record_is_the_s1_original_preset():
 
 @pytest.mark.parametrize("body, needle", [
     ('protocol = "original"\nprotocol_version = 7', "[experiment] protocol_version=7; allowed for protocol = "
-                                                     "'original': [1, 2, 3, 4]"),
+                                                     "'original': [1, 2, 3, 4, 5]"),
     ('protocol = "original"\nprotocol_version = true', "protocol_version=True; allowed for protocol = 'original'"),
     ('protocol = "paper"\nprotocol_version = 2', "[experiment] protocol_version=2; allowed for protocol = 'paper': [1]"),
     ("protocol_version = 2", "[experiment] protocol_version=2 without a protocol; allowed: with protocol"),
@@ -344,7 +352,8 @@ def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_pa
     assert len(whole) == 4 and part == whole
     saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
     assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0
-    assert saved["protocol_version"] == 4 and saved["truncation"] == saved["weights"] == "encog" and saved["environment"]["schedule"] == "shuffled"
+    assert saved["protocol_version"] == 5 and saved["truncation"] == saved["weights"] == "encog"
+    assert saved["environment"]["schedule"] == "shuffled" and saved["substrate"]["bearings"] == "atan"
     shutil.rmtree(tmp_path / "part")
 
 
@@ -831,6 +840,30 @@ def test_the_encog_weights_note_gives_each_methods_own_deviations():
     assert not any("weights = encog" in n for n in protocol_notes(replace(exp, weights="neat")))
 
 
+def test_the_bearings_note_and_the_bearings_run_are_version_5():
+    """The newest bundle's HyperNEAT-M runs say at their start that their sensors sit on the front
+    half; the committed bearings run is the S1-original preset at version 5 key for key, and
+    version 4's own record differs from it by the bearings alone."""
+    from dataclasses import replace
+
+    from evolution.run.trainer import protocol_notes
+
+    path, overrides = resolve_preset("S1-original")
+    exp = load_experiment(path, overrides)
+    assert any("bearings = atan" in n for n in protocol_notes(exp))
+    assert not any("bearings = atan" in n for n in protocol_notes(load_experiment(path, {**(overrides or {}),
+                                                                                       "protocol_version": 4})))
+    assert not any("bearings = atan" in n for n in protocol_notes(replace(exp, method="neat-m")))
+    record = load_experiment(EVIDENCE / "original-S1-v4-atan-bearings" / "experiment.toml")
+    drop = ("name", "source", "protocol", "protocol_version")
+    mine = {k: v for k, v in record.to_dict().items() if k not in drop}
+    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
+    v4 = experiment_from_run(json.loads((EVIDENCE / "original-S1-v4" / "experiment.json").read_text()), "v4")
+    theirs = {k: v for k, v in v4.to_dict().items() if k not in drop}
+    assert {k for k in mine if mine[k] != theirs[k]} == {"substrate"}
+    assert mine["substrate"] == theirs["substrate"] | {"bearings": "atan"}
+
+
 def test_a_one_layout_run_refuses_a_layout_seed_of_its_own(tmp_path):
     path = experiment(tmp_path, body='layout = "per_run"')
     path.write_text(path.read_text() + "layout_seed = 4\n")
@@ -847,8 +880,9 @@ def test_the_front_box_experiment_differs_from_the_newest_bundle_by_the_box_alon
     differ = {k for k in set(front.environment) | set(preset.environment)
               if front.environment.get(k) != preset.environment.get(k)}
     assert differ == {"pickup_box"} and front.environment["pickup_box"] == "front"
-    assert (front.layout, front.elitism, front.complexity, front.speciation, front.substrate) == (
-        preset.layout, preset.elitism, preset.complexity, preset.speciation, preset.substrate)
+    assert (front.layout, front.elitism, front.complexity, front.speciation, front.truncation, front.weights,
+            front.substrate) == (preset.layout, preset.elitism, preset.complexity, preset.speciation,
+                                 preset.truncation, preset.weights, preset.substrate)
 
 
 def test_a_paper_protocol_run_saved_before_the_bundle_grew_resumes_in_the_same_world(tmp_path):

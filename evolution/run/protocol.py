@@ -42,6 +42,8 @@ damping``                                         forces, traction impulse, its 
                                                   physics step shuffled every step
 ``[substrate] decode_window`` 1                   0.2 (middle 20 % of range, FOV, orientation)
 ``[substrate] bias_threshold`` false              true (biases thresholded like link weights)
+``[substrate] bearings``      ``"atan2"``         ``"atan"``: the 2018 decoder's atan(y / x), every
+                                                  sensor on the front half of the body
 ============================  ==================  ================================================
 
 (The time bonus 20, the 5 trials of 10 000 steps, the sensor-type bands' order and the weld that
@@ -64,12 +66,16 @@ newest one whose keys it holds with the same values (``saved_version``). The ori
    in place of version 2's velocity-drive keys, and its MASON schedule (``schedule =
    "shuffled"``): with these the scripted pushing scenes match the original's own classes, and
    the run's trials share its layout and differ by schedule, as the original's five did.
-4. (2026-12, the newest) adds Encog's breeding as the 2018 code configured it: its truncation
+4. (2026-12) adds Encog's breeding as the 2018 code configured it: its truncation
    (``truncation = "encog"``: ``TruncationSelection(0.3)`` keeps max(floor(0.3 n), 1) of a
    species as parents where the earlier versions kept ceil(0.3 n) and at least two, so a
    species of fewer than 7 genomes breeds from its best genome alone, by mutation) and its link
    weights (``weights = "encog"``: uniform in +-5 where the earlier versions drew N(0, 1) clamped
    to +-3; perturbations of deviation 0.02 or 1 (NEAT-M 0.004 or 0.2) where they used 0.5).
+5. (2026-12, the newest) adds the 2018 decoder's sensor bearings (``[substrate] bearings =
+   "atan"``): it placed a HyperNEAT-M sensor at atan(y / x) of its input node, so the nodes behind
+   the body carry their sensors on the front half (at their angle minus pi) and every sensor of
+   the original's robots faces forward, where versions 1-4 placed them all round (atan2).
 
 ``protocol = "paper"`` names the defaults (one version). A file that names a protocol and sets
 one of its keys to another value is refused (``ExperimentError`` naming the file and key);
@@ -100,6 +106,9 @@ ORIGINAL_SCHEDULE = {"schedule": "shuffled"}
 #: (``evolution.reproduction.breeding.truncate``) and link weights (``evolution.reproduction.encog``).
 ORIGINAL_BREEDING = {"truncation": "encog", "weights": "encog"}
 
+#: The 2018 decoder's sensor bearings (version 5; ``evolution.encodings.substrate``).
+ORIGINAL_BEARINGS = {"bearings": "atan"}
+
 #: Protocol name -> version -> {section: {key: value}}; the "paper" values are the defaults of
 #: the dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``), filled in
 #: by ``protocol_values``.
@@ -114,6 +123,9 @@ BUNDLES: dict[str, dict[int, dict[str, dict[str, Any]]]] = {
         4: {"experiment": {**_METHOD, **ORIGINAL_BREEDING},
             "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE},
             "substrate": _SUBSTRATE},
+        5: {"experiment": {**_METHOD, **ORIGINAL_BREEDING},
+            "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE},
+            "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
     },
     "paper": {1: {}},
 }
@@ -131,7 +143,8 @@ ORIGINAL_PHYSICS = (*_CONTACTS, *ORIGINAL_VELOCITY_DRIVE)
 DESCRIPTIONS = {
     "paper": "the paper's text (the defaults)",
     "original": "the 2018 Java code that produced the published figures: one layout per run, ratchet on the best "
-                "genome, Encog's truncation and link weights, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its eq. 2, its "
+                "genome, Encog's truncation and link weights, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its "
+                "sensor bearings (all on the front half), its eq. 2, its "
                 "physics (mass friction, bouncing contacts) and its robot on its shuffled schedule",
 }
 

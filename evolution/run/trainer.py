@@ -86,6 +86,9 @@ def protocol_notes(exp: Experiment) -> list[str]:
         small, large = ENCOG_PERTURB_SIGMAS[exp.method]
         notes.append(f"{exp.name}: Encog's link weights (weights = encog): uniform in +-{ENCOG_WEIGHT_RANGE:g}, perturbed "
                      f"by a deviation of {small:g} or {large:g}, or reset (evolution.reproduction.encog)")
+    if exp.method == "hyperneat-m" and exp.substrate.get("bearings") == "atan":
+        notes.append(f"{exp.name}: the original's sensor bearings (bearings = atan): atan(y / x) of each input node, "
+                     "so every sensor sits on the front half of the body (evolution.encodings.substrate)")
     return notes
 
 
