@@ -137,7 +137,7 @@ BEARING_RULES = ("atan2", "atan")
 def _bearing(x: float, y: float, rule: str = "atan2") -> float:
     """A sensor's bearing from its input node's position: ``atan2`` (all round the body, in
     [-pi, pi)) or the original's ``atan`` of y / x, which folds every node into the front half,
-    (-pi/2, pi/2] (a node at angle theta behind the body lands at theta - pi)."""
+    [-pi/2, pi/2] (a node at angle theta behind the body lands at theta - pi)."""
     if rule == "atan":
         return math.atan(y / x) if x != 0.0 else math.copysign(math.pi / 2, y)
     b = math.atan2(y, x)
