@@ -179,7 +179,7 @@ V4_CELLS = {
     "original-S1-v4-neat-weights": ("Encog's truncation only", "C2", "-"),
     "original-S1-v4-neat-truncation": ("Encog's weights only", "C1", "-"),
     "original-S1-v4": ("version 4 (both), seed 1", "C3", "-"),
-    "original-S1-v4-atan-bearings": ("version 4 with the original's bearings", "C4", "-"),
+    "original-S1-v4-atan-bearings": ("version 5 (version 4 + the original's bearings)", "C4", "-"),
 }
 
 
