@@ -30,9 +30,10 @@ import neat
 import numpy as np
 
 from evolution.guard import ArgumentParser, UsageError, command, int_arg
-from evolution.run.checkpoint import load_checkpoint
 from evolution.run.evaluate import decode_genome
-from evolution.run.recorder import checkpoints_in
+from evolution.run.experiment import experiment_from_run
+from evolution.run.neat_setup import substrate_for
+from evolution.run.rundir import find_checkpoint
 
 
 def phenotype(method: str, genome: Any, config: Any, substrate: Any) -> tuple[np.ndarray, list[Any], tuple]:
@@ -74,14 +75,12 @@ def weight_steps(method: str, genomes: list[Any], config: Any, substrate: Any, m
     }
 
 
-def latest_population(run_dir: Path) -> tuple[dict[str, Any], Any]:
+def latest_population(run_dir: Path) -> tuple[Any, Any]:
+    """(the run's experiment, the population of its newest readable checkpoint), as --resume finds it."""
     if not run_dir.is_dir():
         raise UsageError(f"{run_dir}: run folder not found; allowed: a gathering-evolve run folder")
-    found = checkpoints_in(run_dir)
-    if not found:
-        raise UsageError(f"{run_dir}: no checkpoints/gen-*.ckpt; allowed: a run folder that has saved a generation")
-    state = load_checkpoint(found[-1])
-    return state, state["population"]
+    path, state = find_checkpoint(run_dir, None)
+    return experiment_from_run(state["experiment"], str(path)), state["population"]
 
 
 @command
@@ -95,14 +94,8 @@ def main(argv: list[str] | None = None) -> int:
     keys = ("unchanged", "types changed", "links at the bound", "median step")
     print("| population | weights | mutations | " + " | ".join(keys) + " |")
     print("|---|---|---|" + "---|" * len(keys))
-    for run_dir, state, population in loaded:
-        experiment = state["experiment"]
-        method = experiment["method"]
-        substrate = None
-        if method == "hyperneat-m":
-            from evolution.encodings.substrate import Substrate
-
-            substrate = Substrate(**experiment.get("substrate", {}))
+    for run_dir, experiment, population in loaded:
+        method, substrate = experiment.method, substrate_for(experiment)
         config = population.config
         random.seed(args.seed)
         fresh = neat.Population(config)
@@ -111,7 +104,7 @@ def main(argv: list[str] | None = None) -> int:
             figures = weight_steps(method, list(genomes.values()), config, substrate, args.mutations, args.seed)
             cells = ["–" if np.isnan(figures[k]) else f"{figures[k]:.3g}" if k == "median step" else f"{figures[k]:.0%}"
                      for k in keys]
-            print(f"| {label} | {experiment.get('weights', 'neat')} | {figures['mutations']} | " + " | ".join(cells) + " |")
+            print(f"| {label} | {experiment.weights} | {figures['mutations']} | " + " | ".join(cells) + " |")
     return 0
 
 

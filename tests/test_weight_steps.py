@@ -83,7 +83,7 @@ def test_the_script_reads_a_run_and_refuses_bad_input(steps, tmp_path_factory, t
     assert rows[2].split("|")[6].strip() == "–"       # NEAT-M: no substrate bound
     (tmp_path / "empty").mkdir()
     for args, needle in (([str(so_run), str(tmp_path / "nope")], "run folder not found"),
-                         ([str(tmp_path / "empty")], "no checkpoints/gen-*.ckpt"),
+                         ([str(tmp_path / "empty")], "no checkpoint to resume from"),
                          ([str(so_run), "--mutations", "0"], "--mutations: 0 is out of range")):
         with pytest.raises(SystemExit) if "--mutations" in args else contextlib.nullcontext():
             assert steps.main(args) == 2
