@@ -170,6 +170,10 @@ class WorldConfig:
     ir_response: str = "linear"
     """'linear': 1 - d/range; 'gamma': (1 - d/range) ** ir_gamma (Khepera-like curve)."""
     ir_gamma: float = 3.0
+    colour_response: str = "nearer"
+    """'nearer': a block reads 0.5 + 0.5 (1 - d/range), a wall 0.5 (1 - d/range) (nearer =
+    higher); 'farther': the original's, 0.5 + 0.5 d/range and 0.5 d/range (rising with distance,
+    so a wall at contact reads 0, as nothing does)."""
     bottom_falloff: float = 1.0
     """Distance outside the zone (units) over which the bottom sensor falls from 1 to 0."""
 
@@ -289,6 +293,8 @@ class WorldConfig:
                              "schedule acts on wheel forces; allowed: drive_model='force', or schedule='fixed'")
         if self.ir_response not in ("linear", "gamma"):
             raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma'")
+        if self.colour_response not in ("nearer", "farther"):
+            raise ValueError(f"colour_response={self.colour_response!r}; allowed: 'nearer', 'farther'")
         if self.reward not in REWARDS:
             raise ValueError(f"reward={self.reward!r}; allowed: {', '.join(map(repr, REWARDS))}")
         if self.reward_scope not in REWARD_SCOPES:

@@ -160,7 +160,10 @@ def test_the_versions_of_the_original_bundle():
     v5 = protocol_values("original", 5)
     assert v5["environment"] == v3 and v5["experiment"] == v4["experiment"]
     assert v5["substrate"] == v4["substrate"] | {"bearings": "atan"}
-    assert protocol_values("original") == v5 and ORIGINAL["environment"] == v3
+    v6 = protocol_values("original", 6)
+    assert v6["experiment"] == v5["experiment"] and v6["substrate"] == v5["substrate"]
+    assert v6["environment"] == v3 | {"colour_response": "farther"}
+    assert protocol_values("original") == v6 and ORIGINAL["environment"] == v6["environment"]
     # "paper" names the defaults of every key any version sets
     paper = protocol_values("paper")["environment"]
     assert (paper["drive_model"], paper["damping"], paper["schedule"], paper["drive_dead_band"],
@@ -168,9 +171,10 @@ def test_the_versions_of_the_original_bundle():
     assert (protocol_values("paper")["experiment"]["truncation"], protocol_values("paper")["experiment"]["weights"]) \
         == ("neat", "neat")
     assert protocol_values("paper")["substrate"]["bearings"] == "atan2"
+    assert protocol_values("paper")["environment"]["colour_response"] == "nearer"
 
 
-@pytest.mark.parametrize("version", [1, 2, 3, 4, 5])
+@pytest.mark.parametrize("version", [1, 2, 3, 4, 5, 6])
 def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path, version):
     exp = load_experiment(experiment(tmp_path, body=f'protocol = "original"\nprotocol_version = {version}'))
     saved = exp.to_dict()
@@ -182,6 +186,7 @@ def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path,
     assert again.world_config() == exp.world_config()
     assert again.substrate.get("bearings", "atan2") == exp.substrate.get("bearings", "atan2") == \
         ("atan" if version >= 5 else "atan2")
+    assert again.world_config().colour_response == ("farther" if version >= 6 else "nearer")
 
 
 @pytest.mark.parametrize("folder, version", [("original-S1-2018", 1), ("original-S1-elite02", 1),
@@ -208,7 +213,7 @@ def test_the_five_schedule_record_is_the_s1_original_preset():
 
 @pytest.mark.parametrize("body, needle", [
     ('protocol = "original"\nprotocol_version = 7', "[experiment] protocol_version=7; allowed for protocol = "
-                                                     "'original': [1, 2, 3, 4, 5]"),
+                                                     "'original': [1, 2, 3, 4, 5, 6]"),
     ('protocol = "original"\nprotocol_version = true', "protocol_version=True; allowed for protocol = 'original'"),
     ('protocol = "paper"\nprotocol_version = 2', "[experiment] protocol_version=2; allowed for protocol = 'paper': [1]"),
     ("protocol_version = 2", "[experiment] protocol_version=2 without a protocol; allowed: with protocol"),
@@ -352,8 +357,9 @@ def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_pa
     assert len(whole) == 4 and part == whole
     saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
     assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0
-    assert saved["protocol_version"] == 5 and saved["truncation"] == saved["weights"] == "encog"
+    assert saved["protocol_version"] == 6 and saved["truncation"] == saved["weights"] == "encog"
     assert saved["environment"]["schedule"] == "shuffled" and saved["substrate"]["bearings"] == "atan"
+    assert saved["environment"]["colour_response"] == "farther"
     shutil.rmtree(tmp_path / "part")
 
 
@@ -849,7 +855,7 @@ def test_the_bearings_note_and_the_bearings_run_are_version_5():
     from evolution.run.trainer import protocol_notes
 
     path, overrides = resolve_preset("S1-original")
-    exp = load_experiment(path, overrides)
+    exp = load_experiment(path, {**(overrides or {}), "protocol_version": 5})
     assert any("bearings = atan" in n for n in protocol_notes(exp))
     assert not any("bearings = atan" in n for n in protocol_notes(load_experiment(path, {**(overrides or {}),
                                                                                        "protocol_version": 4})))
@@ -862,6 +868,31 @@ def test_the_bearings_note_and_the_bearings_run_are_version_5():
     theirs = {k: v for k, v in v4.to_dict().items() if k not in drop}
     assert {k for k in mine if mine[k] != theirs[k]} == {"substrate"}
     assert mine["substrate"] == theirs["substrate"] | {"bearings": "atan"}
+
+
+def test_the_colour_note_and_the_version_6_run():
+    """The newest bundle's runs say at their start that their colour reading rises with distance;
+    the committed version-6 run is the S1-original preset key for key and differs from the
+    version-5 run by the colour reading alone."""
+    from dataclasses import replace
+
+    from evolution.run.trainer import protocol_notes
+
+    path, overrides = resolve_preset("S1-original")
+    exp = load_experiment(path, overrides)
+    assert exp.world_config().colour_response == "farther"
+    assert any("colour_response = farther" in n for n in protocol_notes(exp))
+    assert any("colour_response = farther" in n for n in protocol_notes(replace(exp, method="neat-m")))
+    v5 = load_experiment(path, {**(overrides or {}), "protocol_version": 5})
+    assert not any("colour_response" in n for n in protocol_notes(v5))
+    drop = ("name", "source", "protocol", "protocol_version")
+    record = load_experiment(EVIDENCE / "original-S1-v6" / "experiment.toml")
+    mine = {k: v for k, v in record.to_dict().items() if k not in drop}
+    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
+    before = load_experiment(EVIDENCE / "original-S1-v4-atan-bearings" / "experiment.toml")
+    theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
+    assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
+    assert mine["environment"] == theirs["environment"] | {"colour_response": "farther"}
 
 
 def test_a_one_layout_run_refuses_a_layout_seed_of_its_own(tmp_path):

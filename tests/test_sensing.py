@@ -133,6 +133,23 @@ def test_colour_sensor_bands():
     assert both == 0.0
 
 
+def test_colour_sensor_farther_rises_with_distance():
+    """The original's colour reading (``colour_response = "farther"``): d/R in place of 1 - d/R."""
+    col = SensorSpec("colour", 0.0, 0.0, 2.0, math.pi / 3)
+    b = bank([col], colour_response="farther")
+    near = read(b, [(20, 20, 0.0), FAR, FAR], [(20.85, 20, 0.0)])[0, 0]    # block at d = 0.5
+    far = read(b, [(20, 20, 0.0), FAR, FAR], [(21.85, 20, 0.0)])[0, 0]     # block at d = 1.5
+    assert (near, far) == (pytest.approx(0.5 + 0.5 * 0.25), pytest.approx(0.5 + 0.5 * 0.75))
+    wall = read(b, [(39.35, 20, 0.0), FAR, FAR], [(5, 5, 0.0)])[0, 0]
+    assert wall == pytest.approx(0.5 * 0.25)                        # wall at d = 0.5
+    touching = read(b, [(39.85, 20, 0.0), FAR, FAR], [(5, 5, 0.0)])[0, 0]
+    assert touching == pytest.approx(0.0)                          # wall at contact: as nothing
+    nothing = read(b, [(20, 20, 0.0), FAR, FAR], [(5, 5, 0.0)])[0, 0]
+    assert nothing == 0.0
+    robot = read(b, [(20, 20, 0.0), (21.3, 20, 0.0), FAR], [(5, 5, 0.0)])[0, 0]
+    assert robot == 0.0
+
+
 def test_camera_cooperation_ratio():
     cam = SensorSpec("camera", 0.0, 0.0, 10.0, 1.0)
     b = bank([cam], blocks=((0.4, 3), (0.3, 2)))

@@ -104,7 +104,8 @@ def reference_read(morph, cfg, robot_pos, robot_angle, block_pos, block_angle, b
             elif s.type == "ultrasonic":
                 out[i, j] = min(close / 0.95, 1.0)
             elif s.type == "colour":
-                out[i, j] = {"block": 0.5 + 0.5 * close, "wall": 0.5 * close, "robot": 0.0}[kind]
+                level = d / s.range if cfg.colour_response == "farther" else close
+                out[i, j] = {"block": 0.5 + 0.5 * level, "wall": 0.5 * level, "robot": 0.0}[kind]
     return out
 
 
@@ -130,17 +131,18 @@ def scenes(draw):
     seed = draw(st.integers(0, 2**32 - 1))
     # A small arena so that objects are close together and walls are in range.
     size = draw(st.sampled_from([3.0, 6.0, 40.0]))
-    return morph, n, b, seed, size
+    colour = draw(st.sampled_from(["nearer", "farther"]))
+    return morph, n, b, seed, size, colour
 
 
 @settings(max_examples=150, deadline=None)
 @given(scenes())
 def test_kernel_matches_reference(scene):
-    morph, n, b, seed, size = scene
+    morph, n, b, seed, size, colour = scene
     rng = np.random.default_rng(seed)
     cfg = WorldConfig.from_kwargs(environment=None, block_counts=(max(b, 1), 0, 0), num_robots=n,
                                   arena_width=size, arena_height=size, zone_width=size / 2,
-                                  zone_depth=size / 5)
+                                  zone_depth=size / 5, colour_response=colour)
     robot_pos = rng.uniform(0.2, size - 0.2, (n, 2))
     robot_angle = rng.uniform(-math.pi, math.pi, n)
     block_pos = rng.uniform(0.5, size - 0.5, (b, 2))

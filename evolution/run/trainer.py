@@ -89,6 +89,9 @@ def protocol_notes(exp: Experiment) -> list[str]:
     if exp.method == "hyperneat-m" and exp.substrate.get("bearings") == "atan":
         notes.append(f"{exp.name}: the original's sensor bearings (bearings = atan): atan(y / x) of each input node, "
                      "so every sensor sits on the front half of the body (evolution.encodings.substrate)")
+    if exp.environment.get("colour_response") == "farther":
+        notes.append(f"{exp.name}: the original's colour reading (colour_response = farther): a block reads "
+                     "0.5 + d/2R, a wall d/2R, rising with distance d (gathering_env.reference.sensing)")
     return notes
 
 

@@ -13,6 +13,7 @@ from numba import njit
 from .tables import (
     BOTTOM,
     CAMERA,
+    F_COLOUR_FARTHER,
     F_IR_GAMMA,
     IR,
     P_ARENA_H,
@@ -83,6 +84,7 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
     r = params[P_RADIUS]
     width, height = params[P_ARENA_W], params[P_ARENA_H]
     use_gamma = flags[F_IR_GAMMA] != 0
+    farther = flags[F_COLOUR_FARTHER] != 0
     gamma = params[P_IR_GAMMA]
     max_range = 0.0
     has_cone = False
@@ -199,10 +201,11 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
                     elif kind == US:
                         value = min(closeness / 0.95, 1.0)
                     elif d_any < rng:  # colour
+                        level = 1.0 - closeness if farther else closeness
                         if d_block[s] <= d_any:
-                            value = 0.5 + 0.5 * closeness
+                            value = 0.5 + 0.5 * level
                         elif d_wall <= d_any and d_robot[s] > d_any:
-                            value = 0.5 * closeness
+                            value = 0.5 * level
                 out[w, i, s] = value
 
 

@@ -18,7 +18,9 @@ Readings, all in [0, 1] (d = distance to the closest seen object, R = range):
 * infrared: ``1 - d/R`` (or ``(1 - d/R) ** gamma``), 0 when nothing is seen.
 * ultrasonic: 1 for ``d <= 0.05 R``, then linear down to 0 at ``d = R``.
 * colour: closest object a block -> ``0.5 + 0.5 (1 - d/R)`` in (0.5, 1];
-  a wall -> ``0.5 (1 - d/R)`` in (0, 0.5]; a robot or nothing -> 0.
+  a wall -> ``0.5 (1 - d/R)`` in (0, 0.5]; a robot or nothing -> 0. With
+  ``colour_response = "farther"`` (the original's) ``d/R`` takes the place of ``1 - d/R``:
+  a block in [0.5, 1), a wall in [0, 0.5), rising with distance.
 * camera: with n robots seen, R' = n + 1 and Q = sum of robots needed by the blocks seen:
   ``R'/Q`` if Q > 0 and R' <= Q, else 0. Walls are not seen by the camera.
 * bottom: 1 with the robot's centre over the zone, falling linearly to 0 at
@@ -196,8 +198,9 @@ class SensorBank:
             if US in present:
                 readings = np.where(self._is[US], np.minimum(closeness / 0.95, 1.0), readings)
             if COLOUR in present:
-                colour = np.where(d_block <= d_any, 0.5 + 0.5 * closeness,
-                                  np.where((d_wall <= d_any) & (d_robot > d_any), 0.5 * closeness, 0.0))
+                level = 1.0 - closeness if cfg.colour_response == "farther" else closeness
+                colour = np.where(d_block <= d_any, 0.5 + 0.5 * level,
+                                  np.where((d_wall <= d_any) & (d_robot > d_any), 0.5 * level, 0.0))
                 readings = np.where(self._is[COLOUR] & (d_any < rng), colour, readings)
         if self._needs_camera:
             team = robots_seen + 1.0
