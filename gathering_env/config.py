@@ -174,6 +174,13 @@ class WorldConfig:
     """'nearer': a block reads 0.5 + 0.5 (1 - d/range), a wall 0.5 (1 - d/range) (nearer =
     higher); 'farther': the original's, 0.5 + 0.5 d/range and 0.5 d/range (rising with distance,
     so a wall at contact reads 0, as nothing does)."""
+    block_sighting: str = "cone"
+    """How a cone sensor sees a block. 'cone': where the block's nearest point to the mount lies
+    inside the cone and within range, at that distance. 'rays': the original's three rays, the
+    axis (length range) and the two cone edges (to x = range): the first of them that enters the
+    block, in that order, gives the distance (its projection on the axis), else the block is
+    unseen unless the mount lies inside it (distance 0); a block whose nearest point is out of
+    range is unseen either way. Robots and walls are seen over the whole cone in both."""
     bottom_falloff: float = 1.0
     """Distance outside the zone (units) over which the bottom sensor falls from 1 to 0."""
 
@@ -293,6 +300,8 @@ class WorldConfig:
                              "schedule acts on wheel forces; allowed: drive_model='force', or schedule='fixed'")
         if self.ir_response not in ("linear", "gamma"):
             raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma'")
+        if self.block_sighting not in ("cone", "rays"):
+            raise ValueError(f"block_sighting={self.block_sighting!r}; allowed: 'cone', 'rays'")
         if self.colour_response not in ("nearer", "farther"):
             raise ValueError(f"colour_response={self.colour_response!r}; allowed: 'nearer', 'farther'")
         if self.reward not in REWARDS:

@@ -163,7 +163,10 @@ def test_the_versions_of_the_original_bundle():
     v6 = protocol_values("original", 6)
     assert v6["experiment"] == v5["experiment"] and v6["substrate"] == v5["substrate"]
     assert v6["environment"] == v3 | {"colour_response": "farther"}
-    assert protocol_values("original") == v6 and ORIGINAL["environment"] == v6["environment"]
+    v7 = protocol_values("original", 7)
+    assert v7["experiment"] == v6["experiment"] and v7["substrate"] == v6["substrate"]
+    assert v7["environment"] == v6["environment"] | {"block_sighting": "rays"}
+    assert protocol_values("original") == v7 and ORIGINAL["environment"] == v7["environment"]
     # "paper" names the defaults of every key any version sets
     paper = protocol_values("paper")["environment"]
     assert (paper["drive_model"], paper["damping"], paper["schedule"], paper["drive_dead_band"],
@@ -172,9 +175,10 @@ def test_the_versions_of_the_original_bundle():
         == ("neat", "neat")
     assert protocol_values("paper")["substrate"]["bearings"] == "atan2"
     assert protocol_values("paper")["environment"]["colour_response"] == "nearer"
+    assert protocol_values("paper")["environment"]["block_sighting"] == "cone"
 
 
-@pytest.mark.parametrize("version", [1, 2, 3, 4, 5, 6])
+@pytest.mark.parametrize("version", [1, 2, 3, 4, 5, 6, 7])
 def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path, version):
     exp = load_experiment(experiment(tmp_path, body=f'protocol = "original"\nprotocol_version = {version}'))
     saved = exp.to_dict()
@@ -187,6 +191,7 @@ def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path,
     assert again.substrate.get("bearings", "atan2") == exp.substrate.get("bearings", "atan2") == \
         ("atan" if version >= 5 else "atan2")
     assert again.world_config().colour_response == ("farther" if version >= 6 else "nearer")
+    assert again.world_config().block_sighting == ("rays" if version >= 7 else "cone")
 
 
 @pytest.mark.parametrize("folder, version", [("original-S1-2018", 1), ("original-S1-elite02", 1),
@@ -212,8 +217,8 @@ def test_the_five_schedule_record_is_the_s1_original_preset():
 
 
 @pytest.mark.parametrize("body, needle", [
-    ('protocol = "original"\nprotocol_version = 7', "[experiment] protocol_version=7; allowed for protocol = "
-                                                     "'original': [1, 2, 3, 4, 5, 6]"),
+    ('protocol = "original"\nprotocol_version = 8', "[experiment] protocol_version=8; allowed for protocol = "
+                                                     "'original': [1, 2, 3, 4, 5, 6, 7]"),
     ('protocol = "original"\nprotocol_version = true', "protocol_version=True; allowed for protocol = 'original'"),
     ('protocol = "paper"\nprotocol_version = 2', "[experiment] protocol_version=2; allowed for protocol = 'paper': [1]"),
     ("protocol_version = 2", "[experiment] protocol_version=2 without a protocol; allowed: with protocol"),
@@ -357,9 +362,9 @@ def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_pa
     assert len(whole) == 4 and part == whole
     saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
     assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0
-    assert saved["protocol_version"] == 6 and saved["truncation"] == saved["weights"] == "encog"
+    assert saved["protocol_version"] == 7 and saved["truncation"] == saved["weights"] == "encog"
     assert saved["environment"]["schedule"] == "shuffled" and saved["substrate"]["bearings"] == "atan"
-    assert saved["environment"]["colour_response"] == "farther"
+    assert saved["environment"]["colour_response"] == "farther" and saved["environment"]["block_sighting"] == "rays"
     shutil.rmtree(tmp_path / "part")
 
 
@@ -871,15 +876,15 @@ def test_the_bearings_note_and_the_bearings_run_are_version_5():
 
 
 def test_the_colour_note_and_the_version_6_run():
-    """The newest bundle's runs say at their start that their colour reading rises with distance;
-    the committed version-6 run is the S1-original preset key for key and differs from the
-    version-5 run by the colour reading alone."""
+    """Version 6's runs say at their start that their colour reading rises with distance; the
+    committed version-6 run is the S1-original preset at version 6 key for key and differs from
+    the version-5 run by the colour reading alone."""
     from dataclasses import replace
 
     from evolution.run.trainer import protocol_notes
 
     path, overrides = resolve_preset("S1-original")
-    exp = load_experiment(path, overrides)
+    exp = load_experiment(path, {**(overrides or {}), "protocol_version": 6})
     assert exp.world_config().colour_response == "farther"
     assert any("colour_response = farther" in n for n in protocol_notes(exp))
     assert any("colour_response = farther" in n for n in protocol_notes(replace(exp, method="neat-m")))
@@ -893,6 +898,31 @@ def test_the_colour_note_and_the_version_6_run():
     theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
     assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
     assert mine["environment"] == theirs["environment"] | {"colour_response": "farther"}
+
+
+def test_the_sighting_note_and_the_version_7_run():
+    """The newest bundle's runs say at their start that blocks are seen along three rays; the
+    committed version-7 run is the S1-original preset key for key and differs from the version-6
+    run by the block sighting alone."""
+    from dataclasses import replace
+
+    from evolution.run.trainer import protocol_notes
+
+    path, overrides = resolve_preset("S1-original")
+    exp = load_experiment(path, overrides)
+    assert exp.world_config().block_sighting == "rays"
+    assert any("block_sighting = rays" in n for n in protocol_notes(exp))
+    assert any("block_sighting = rays" in n for n in protocol_notes(replace(exp, method="neat-m")))
+    v6 = load_experiment(path, {**(overrides or {}), "protocol_version": 6})
+    assert not any("block_sighting" in n for n in protocol_notes(v6))
+    drop = ("name", "source", "protocol", "protocol_version")
+    record = load_experiment(EVIDENCE / "original-S1-v7" / "experiment.toml")
+    mine = {k: v for k, v in record.to_dict().items() if k not in drop}
+    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
+    before = load_experiment(EVIDENCE / "original-S1-v6" / "experiment.toml")
+    theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
+    assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
+    assert mine["environment"] == theirs["environment"] | {"block_sighting": "rays"}
 
 
 def test_a_one_layout_run_refuses_a_layout_seed_of_its_own(tmp_path):

@@ -133,6 +133,39 @@ def test_colour_sensor_bands():
     assert both == 0.0
 
 
+def test_block_sighting_by_the_originals_three_rays():
+    """``block_sighting = "rays"``: a block is seen where the axis or a cone edge enters it, at
+    the entry's projection on the axis; between the rays it is unseen; a mount inside it sees it
+    at 0. Mount at (20.15, 20) facing +x, cone of 90 degrees, range 4; blocks of half side 0.2."""
+    col = SensorSpec("colour", 0.0, 0.0, 4.0, math.pi / 2)
+    cone, rays = bank([col]), bank([col], block_sighting="rays")
+    me = [(20, 20, 0.0), FAR, FAR]
+    # on the axis: entry at x = 21.15, d = 1 either way
+    assert read(rays, me, [(21.35, 20, 0.0)])[0, 0] == read(cone, me, [(21.35, 20, 0.0)])[0, 0] \
+        == pytest.approx(0.5 + 0.5 * 0.75)
+    # 22.5 degrees off the axis at 2 units: inside the cone, between the rays
+    between = [(20.15 + 2 * math.cos(math.pi / 8), 20 + 2 * math.sin(math.pi / 8), 0.0)]
+    assert read(rays, me, between)[0, 0] == 0.0
+    assert read(cone, me, between)[0, 0] == pytest.approx(0.5 + 0.5 * (1 - (2 - 0.2 / math.cos(math.pi / 8)) / 4),
+                                                           abs=0.02)
+    # across the left edge (45 degrees): it enters the side x = 21.05 at (21.05, 20.9), 0.9 along
+    # the axis; the cone sees its nearest point (21.05, 20.8) at hypot(0.9, 0.8)
+    edge = [(21.25, 21.0, 0.0)]
+    assert read(rays, me, edge)[0, 0] == pytest.approx(0.5 + 0.5 * (1 - 0.9 / 4))
+    assert read(cone, me, edge)[0, 0] == pytest.approx(0.5 + 0.5 * (1 - math.hypot(0.9, 0.8) / 4))
+    # the right edge likewise (mirror image)
+    assert read(rays, me, [(21.25, 19.0, 0.0)])[0, 0] == pytest.approx(0.5 + 0.5 * (1 - 0.9 / 4))
+    # the mount inside the block: no ray enters it, the point test sees it at 0
+    assert read(rays, me, [(20.3, 20, 0.0)])[0, 0] == pytest.approx(1.0)
+    # out of range: the axis ray (length 4) stops short of a block whose side is at 4.2
+    assert read(rays, me, [(20.15 + 4.4, 20, 0.0)])[0, 0] == 0.0
+    # an edge ray runs to x = range, beyond the arc: a wide cone (150 degrees, range 2) sees a
+    # large block (half side 0.4) through its left edge 2.32 along the ray, where it enters the
+    # side x = 20.75 at y = 20 + 0.6 tan(75 deg), 0.6 along the axis; the axis misses it
+    wide = bank([SensorSpec("colour", 0.0, 0.0, 2.0, 5 * math.pi / 6)], blocks=((0.4, 3),), block_sighting="rays")
+    assert read(wide, me, [(21.15, 21.85, 0.0)])[0, 0] == pytest.approx(0.5 + 0.5 * (1 - 0.6 / 2))
+
+
 def test_colour_sensor_farther_rises_with_distance():
     """The original's colour reading (``colour_response = "farther"``): d/R in place of 1 - d/R."""
     col = SensorSpec("colour", 0.0, 0.0, 2.0, math.pi / 3)

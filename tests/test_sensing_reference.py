@@ -56,6 +56,43 @@ def _wall_distance(mount, axis, half_fov, cfg):
     return best
 
 
+def _square_corners(centre, half, angle):
+    c, s = math.cos(angle), math.sin(angle)
+    local = [(-half, -half), (half, -half), (half, half), (-half, half)]
+    return [(centre[0] + x * c - y * s, centre[1] + x * s + y * c) for x, y in local]
+
+
+def _ray_hits_square(origin, angle, length, corners):
+    """Smallest t in [0, length] where the ray origin + t (cos, sin) crosses one of the square's
+    four sides (segment against segment, by Cramer's rule), or None."""
+    dx, dy = math.cos(angle), math.sin(angle)
+    best = None
+    for a, b in zip(corners, corners[1:] + corners[:1]):
+        ex, ey = b[0] - a[0], b[1] - a[1]
+        det = ex * dy - dx * ey
+        if abs(det) < 1e-15:
+            continue
+        wx, wy = a[0] - origin[0], a[1] - origin[1]
+        t = (ex * wy - wx * ey) / det
+        u = (dx * wy - wx * dy) / det
+        if -1e-12 <= u <= 1 + 1e-12 and 0 <= t <= length and (best is None or t < best):
+            best = t
+    return best
+
+
+def _rays_distance(mount, axis, s, centre, half, angle):
+    """The original's sighting of a square by three rays (docs/model.md §3), or None."""
+    if _distance_to_square(mount, centre, half, angle) == 0.0:
+        return 0.0              # the mount inside: no ray enters, the point test sees it
+    corners = _square_corners(centre, half, angle)
+    cos_half = math.cos(s.fov / 2)
+    for offset, length in ((0.0, s.range), (s.fov / 2, s.range / cos_half), (-s.fov / 2, s.range / cos_half)):
+        t = _ray_hits_square(mount, axis + offset, length, corners)
+        if t is not None:
+            return t * math.cos(offset)
+    return None
+
+
 def reference_read(morph, cfg, robot_pos, robot_angle, block_pos, block_angle, block_half, block_need):
     n = len(robot_pos)
     out = np.zeros((n, len(morph)))
@@ -85,7 +122,11 @@ def reference_read(morph, cfg, robot_pos, robot_angle, block_pos, block_angle, b
                 q = _nearest_on_square(mount, block_pos[b], block_half[b], block_angle[b])
                 dist = _distance_to_square(mount, block_pos[b], block_half[b], block_angle[b])
                 inside_cone = dist < 1e-12 or _angle_diff(math.atan2(q[1] - mount[1], q[0] - mount[0]), axis) <= s.fov / 2 + 1e-12
-                if inside_cone and dist < s.range:
+                if cfg.block_sighting == "rays":
+                    ray = _rays_distance(mount, axis, s, block_pos[b], block_half[b], block_angle[b])
+                    if ray is not None and dist < s.range:
+                        seen.append((ray, "block", block_need[b]))
+                elif inside_cone and dist < s.range:
                     seen.append((dist, "block", block_need[b]))
             if s.type == "camera":
                 robots = sum(1 for d, kind, _ in seen if kind == "robot") + 1
@@ -132,17 +173,19 @@ def scenes(draw):
     # A small arena so that objects are close together and walls are in range.
     size = draw(st.sampled_from([3.0, 6.0, 40.0]))
     colour = draw(st.sampled_from(["nearer", "farther"]))
-    return morph, n, b, seed, size, colour
+    sighting = draw(st.sampled_from(["cone", "rays"]))
+    return morph, n, b, seed, size, colour, sighting
 
 
 @settings(max_examples=150, deadline=None)
 @given(scenes())
 def test_kernel_matches_reference(scene):
-    morph, n, b, seed, size, colour = scene
+    morph, n, b, seed, size, colour, sighting = scene
     rng = np.random.default_rng(seed)
     cfg = WorldConfig.from_kwargs(environment=None, block_counts=(max(b, 1), 0, 0), num_robots=n,
                                   arena_width=size, arena_height=size, zone_width=size / 2,
-                                  zone_depth=size / 5, colour_response=colour)
+                                  zone_depth=size / 5, colour_response=colour,
+                                  block_sighting=sighting)
     robot_pos = rng.uniform(0.2, size - 0.2, (n, 2))
     robot_angle = rng.uniform(-math.pi, math.pi, n)
     block_pos = rng.uniform(0.5, size - 0.5, (b, 2))

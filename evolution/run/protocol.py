@@ -33,6 +33,8 @@ key                           paper (default)     original
 ``[environment] ir_response`` ``"linear"``        ``"gamma"`` (the Khepera-like curve)
 ``[environment]               ``"nearer"``        ``"farther"``: the colour reading rises with
 colour_response``                                 distance (block 0.5 + d/2R, wall d/2R)
+``[environment]               ``"cone"``          ``"rays"``: a cone sensor sees a block only
+block_sighting``                                  along its axis and its two edges (three rays)
 ``[environment]               ``"threshold"``     ``"mass"``: kinetic Coulomb friction 0.1 m g
 ground_friction``                                 whatever the robots needed (docs/fidelity.md)
 ``[environment] robot_,       0, 0, 0             1, 0.4, 1 (Box2D's: a contact takes the larger)
@@ -78,10 +80,14 @@ newest one whose keys it holds with the same values (``saved_version``). The ori
    placed a HyperNEAT-M sensor at atan(y / x) of its input node, so the nodes behind the body
    carry their sensors on the front half (at their angle minus pi) and every sensor of the
    original's robots faces forward, where versions 1-4 placed them all round (atan2).
-6. (2026-12, the newest) adds the 2018 code's colour reading (``[environment] colour_response =
+6. (2026-12) adds the 2018 code's colour reading (``[environment] colour_response =
    "farther"``): its colour sensor read a block as 0.5 + d / 2R and a wall as d / 2R (d the
    distance, R the range), rising with distance, where versions 1-5 read 1 - d / R in its place
    (nearer = higher); a wall at contact then reads 0, as nothing does.
+7. (2026-12, the newest) adds the 2018 simulator's block sighting (``[environment]
+   block_sighting = "rays"``): its cone sensors find a block (a Box2D polygon) by three ray casts,
+   the axis and the two cone edges, so a block lying in the cone between them is unseen, where
+   versions 1-6 saw any block whose nearest point lies in the cone.
 
 ``protocol = "paper"`` names the defaults (one version). A file that names a protocol and sets
 one of its keys to another value is refused (``ExperimentError`` naming the file and key);
@@ -118,6 +124,9 @@ ORIGINAL_BEARINGS = {"bearings": "atan"}
 #: The 2018 code's colour reading (version 6; ``gathering_env.reference.sensing``).
 ORIGINAL_COLOUR = {"colour_response": "farther"}
 
+#: The 2018 simulator's block sighting (version 7; ``gathering_env.reference.sensing.ray_sighting``).
+ORIGINAL_SIGHTING = {"block_sighting": "rays"}
+
 #: Protocol name -> version -> {section: {key: value}}; the "paper" values are the defaults of
 #: the dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``), filled in
 #: by ``protocol_values``.
@@ -138,6 +147,10 @@ BUNDLES: dict[str, dict[int, dict[str, dict[str, Any]]]] = {
         6: {"experiment": {**_METHOD, **ORIGINAL_BREEDING},
             "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE, **ORIGINAL_COLOUR},
             "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
+        7: {"experiment": {**_METHOD, **ORIGINAL_BREEDING},
+            "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE, **ORIGINAL_COLOUR,
+                            **ORIGINAL_SIGHTING},
+            "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
     },
     "paper": {1: {}},
 }
@@ -156,7 +169,7 @@ DESCRIPTIONS = {
     "paper": "the paper's text (the defaults)",
     "original": "the 2018 Java code that produced the published figures: one layout per run, ratchet on the best "
                 "genome, Encog's truncation and link weights, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its "
-                "sensor bearings (all on the front half), its colour reading (rising with distance), its eq. 2, its "
+                "sensor bearings (all on the front half), its colour reading (rising with distance) and block sighting (three rays), its eq. 2, its "
                 "physics (mass friction, bouncing contacts) and its robot on its shuffled schedule",
 }
 

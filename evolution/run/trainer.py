@@ -92,6 +92,9 @@ def protocol_notes(exp: Experiment) -> list[str]:
     if exp.environment.get("colour_response") == "farther":
         notes.append(f"{exp.name}: the original's colour reading (colour_response = farther): a block reads "
                      "0.5 + d/2R, a wall d/2R, rising with distance d (gathering_env.reference.sensing)")
+    if exp.environment.get("block_sighting") == "rays":
+        notes.append(f"{exp.name}: the original's block sighting (block_sighting = rays): a sensor sees a block only "
+                     "along its axis and its two cone edges (gathering_env.reference.sensing)")
     return notes
 
 

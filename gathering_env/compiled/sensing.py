@@ -13,6 +13,7 @@ from numba import njit
 from .tables import (
     BOTTOM,
     CAMERA,
+    F_BLOCK_RAYS,
     F_COLOUR_FARTHER,
     F_IR_GAMMA,
     IR,
@@ -67,6 +68,45 @@ def _wall_distance(mx, my, hx, hy, cos_half, sin_half, width, height):
 
 
 @njit(cache=True)
+def _ray_entry(ox, oy, dx, dy, half, length):
+    """``gathering_env.reference.sensing.ray_entry`` for one ray."""
+    t0 = -np.inf
+    t1 = np.inf
+    for axis in range(2):
+        o = ox if axis == 0 else oy
+        d = dx if axis == 0 else dy
+        if d == 0.0:
+            if abs(o) > half:
+                return np.inf
+            continue
+        ta = (-half - o) / d
+        tb = (half - o) / d
+        t0 = max(t0, min(ta, tb))
+        t1 = min(t1, max(ta, tb))
+    if t0 <= t1 and 0.0 <= t0 <= length:
+        return t0
+    return np.inf
+
+
+@njit(cache=True)
+def _ray_sighting(lx, ly, ax, ay, half, cos_half, sin_half, rng):
+    """``gathering_env.reference.sensing.ray_sighting`` for one sensor and block."""
+    t = _ray_entry(lx, ly, ax, ay, half, rng)
+    if t < np.inf:
+        return t
+    edge = rng / max(cos_half, 1e-12)
+    t = _ray_entry(lx, ly, ax * cos_half - ay * sin_half, ax * sin_half + ay * cos_half, half, edge)
+    if t < np.inf:
+        return t * cos_half
+    t = _ray_entry(lx, ly, ax * cos_half + ay * sin_half, ay * cos_half - ax * sin_half, half, edge)
+    if t < np.inf:
+        return t * cos_half
+    if abs(lx) <= half and abs(ly) <= half:
+        return 0.0
+    return np.inf
+
+
+@njit(cache=True)
 def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need,
           table, params, flags, active, out):
     """Readings of every sensor of every robot in every active world.
@@ -85,6 +125,7 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
     width, height = params[P_ARENA_W], params[P_ARENA_H]
     use_gamma = flags[F_IR_GAMMA] != 0
     farther = flags[F_COLOUR_FARTHER] != 0
+    rays = flags[F_BLOCK_RAYS] != 0
     gamma = params[P_IR_GAMMA]
     max_range = 0.0
     has_cone = False
@@ -175,7 +216,16 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
                         dot = vx * (hx[s] * c + hy[s] * sn) + vy * (hy[s] * c - hx[s] * sn)
                         centre = math.sqrt(vx * vx + vy * vy)
                         dist = max(centre, 0.0)
-                        if dot >= centre * table[s, T_COS_HALF] and dist < table[s, T_RANGE]:
+                        if rays:
+                            if dist >= table[s, T_RANGE]:
+                                continue
+                            dist = _ray_sighting(lx, ly, hx[s] * c + hy[s] * sn, hy[s] * c - hx[s] * sn, half,
+                                                 table[s, T_COS_HALF], table[s, T_SIN_HALF], table[s, T_RANGE])
+                            if dist < np.inf:
+                                if dist < d_block[s]:
+                                    d_block[s] = dist
+                                need_seen[s] += block_need[b]
+                        elif dot >= centre * table[s, T_COS_HALF] and dist < table[s, T_RANGE]:
                             if dist < d_block[s]:
                                 d_block[s] = dist
                             need_seen[s] += block_need[b]

@@ -11,7 +11,11 @@ Geometry (docs/model.md §3). Sensor *s* of robot *i* sits on the rim at
 nearest point to the mount lies inside the cone (half-angle fov/2 about the axis) and
 strictly within ``range``. Walls are infinite lines: the reading uses the nearest wall
 point inside the cone (at the cone edge when the wall's normal lies outside the cone).
-Occlusion is not modelled: an object behind another one is still seen.
+Occlusion is not modelled: an object behind another one is still seen. With ``block_sighting =
+"rays"`` (the original's) a block is seen only where one of three rays from the mount enters it:
+the axis (length R), else the cone's left edge, else its right edge (each to x = R in the
+sensor's frame), at the distance of the entry point projected on the axis; or at distance 0 if
+the mount lies inside it (``ray_sighting``).
 
 Readings, all in [0, 1] (d = distance to the closest seen object, R = range):
 
@@ -178,6 +182,11 @@ class SensorBank:
             dist = np.maximum(centre - self._obj_radius[kk, None], 0.0)
             seen = (dot >= centre * self._cos_half_c) & (dist < rng)
             is_robot = self._obj_is_robot[kk, None]
+            if cfg.block_sighting == "rays":
+                ray = ray_sighting(lx, ly, hxi * c + hyi * s, hyi * c - hxi * s, half,
+                                   self._cos_half_c, self._sin_half_c, rng)
+                seen = np.where(is_robot, seen, np.isfinite(ray) & (dist < rng))
+                dist = np.where(is_robot, dist, ray)
             starts = np.flatnonzero(np.concatenate(([True], ii[1:] != ii[:-1])))
             rows = ii[starts]
             d_robot[rows] = np.minimum.reduceat(np.where(seen & is_robot, dist, np.inf), starts)
@@ -228,6 +237,43 @@ class SensorBank:
         return dist.min(axis=-1)
 
 
+def ray_entry(ox, oy, dx, dy, half, length):
+    """Parameter t at which the ray ``o + t d`` (d a unit vector) enters the square
+    [-half, half]^2, for 0 <= t <= length; inf if it misses there or starts inside (as Box2D's
+    ray cast, which reports no hit from inside a polygon). Arrays broadcast."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        bounds = []
+        for o, d in ((ox, dx), (oy, dy)):
+            t1, t2 = (-half - o) / d, (half - o) / d
+            within = np.abs(o) <= half
+            lo = np.where(d == 0, np.where(within, -np.inf, np.inf), np.minimum(t1, t2))
+            hi = np.where(d == 0, np.where(within, np.inf, -np.inf), np.maximum(t1, t2))
+            bounds.append((lo, hi))
+    t0 = np.maximum(bounds[0][0], bounds[1][0])
+    t1 = np.minimum(bounds[0][1], bounds[1][1])
+    return np.where((t0 <= t1) & (t0 >= 0.0) & (t0 <= length), t0, np.inf)
+
+
+def ray_sighting(lx, ly, ax, ay, half, cos_half, sin_half, rng):
+    """Distance at which the original's three rays see a square block (inf: unseen).
+
+    In the block's frame: the mount at (lx, ly), the sensor axis (ax, ay) (unit), a cone of
+    half-angle with cosine/sine ``cos_half``/``sin_half`` and range ``rng``. The axis ray (length
+    rng) is tried first, then the edge at +half, then at -half (each to x = rng in the sensor's
+    frame, length rng / cos_half); the first entry's distance projected on the axis is returned,
+    else 0 if the mount lies inside the block."""
+    up_x, up_y = ax * cos_half - ay * sin_half, ax * sin_half + ay * cos_half
+    dn_x, dn_y = ax * cos_half + ay * sin_half, ay * cos_half - ax * sin_half
+    edge = rng / np.maximum(cos_half, 1e-12)
+    t_axis = ray_entry(lx, ly, ax, ay, half, rng)
+    t_up = ray_entry(lx, ly, up_x, up_y, half, edge)
+    t_dn = ray_entry(lx, ly, dn_x, dn_y, half, edge)
+    inside = (np.abs(lx) <= half) & (np.abs(ly) <= half)
+    return np.where(np.isfinite(t_axis), t_axis,
+                    np.where(np.isfinite(t_up), t_up * cos_half,
+                             np.where(np.isfinite(t_dn), t_dn * cos_half, np.where(inside, 0.0, np.inf))))
+
+
 def sensor_bank(morphology: Morphology, config: WorldConfig, block_half_sizes: np.ndarray,
                 block_needs: np.ndarray):
     """The sensing of ``config.kernel``: this module's ``SensorBank`` ('numpy') or
@@ -239,4 +285,4 @@ def sensor_bank(morphology: Morphology, config: WorldConfig, block_half_sizes: n
     return SensorBank(morphology, config, block_half_sizes, block_needs)
 
 
-__all__ = ["SensorBank", "sensor_bank", "IR", "US", "COLOUR", "CAMERA", "BOTTOM"]
+__all__ = ["SensorBank", "sensor_bank", "ray_entry", "ray_sighting", "IR", "US", "COLOUR", "CAMERA", "BOTTOM"]
