@@ -168,7 +168,9 @@ class WorldConfig:
 
     # --- sensing ---------------------------------------------------------------------
     ir_response: str = "linear"
-    """'linear': 1 - d/range; 'gamma': (1 - d/range) ** ir_gamma (Khepera-like curve)."""
+    """'linear': 1 - d/range; 'gamma': (1 - d/range) ** ir_gamma (a steeper proximity curve);
+    'khepera': the original's, a Gamma density over 200 d/range (``gathering_env.khepera``),
+    0 at contact, 1 at 1.3-1.8 % of the range, below 0.01 beyond 8.8 %."""
     ir_gamma: float = 3.0
     colour_response: str = "nearer"
     """'nearer': a block reads 0.5 + 0.5 (1 - d/range), a wall 0.5 (1 - d/range) (nearer =
@@ -183,6 +185,11 @@ class WorldConfig:
     range is unseen either way. Robots and walls are seen over the whole cone in both."""
     bottom_falloff: float = 1.0
     """Distance outside the zone (units) over which the bottom sensor falls from 1 to 0."""
+    bottom_response: str = "linear"
+    """'linear': the bottom sensor reads under the robot's centre, 1 over the zone, falling to 0
+    over ``bottom_falloff``; 'khepera': the original's, a disc 0.95 radii ahead of the centre
+    read through the Khepera curve (``gathering_env.khepera``): on over the zone, off within
+    about 0.01 of it."""
 
     # --- scoring ---------------------------------------------------------------------
     time_bonus: float = 20.0
@@ -298,8 +305,10 @@ class WorldConfig:
         if self.schedule == "shuffled" and self.drive_model != "force":
             raise ValueError(f"schedule='shuffled' with drive_model={self.drive_model!r}: the shuffled "
                              "schedule acts on wheel forces; allowed: drive_model='force', or schedule='fixed'")
-        if self.ir_response not in ("linear", "gamma"):
-            raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma'")
+        if self.ir_response not in ("linear", "gamma", "khepera"):
+            raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma', 'khepera'")
+        if self.bottom_response not in ("linear", "khepera"):
+            raise ValueError(f"bottom_response={self.bottom_response!r}; allowed: 'linear', 'khepera'")
         if self.block_sighting not in ("cone", "rays"):
             raise ValueError(f"block_sighting={self.block_sighting!r}; allowed: 'cone', 'rays'")
         if self.colour_response not in ("nearer", "farther"):

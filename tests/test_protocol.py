@@ -166,7 +166,11 @@ def test_the_versions_of_the_original_bundle():
     v7 = protocol_values("original", 7)
     assert v7["experiment"] == v6["experiment"] and v7["substrate"] == v6["substrate"]
     assert v7["environment"] == v6["environment"] | {"block_sighting": "rays"}
-    assert protocol_values("original") == v7 and ORIGINAL["environment"] == v7["environment"]
+    v8 = protocol_values("original", 8)
+    assert v8["experiment"] == v7["experiment"] and v8["substrate"] == v7["substrate"]
+    assert v8["environment"] == v7["environment"] | {"ir_response": "khepera", "bottom_response": "khepera"}
+    assert v7["environment"]["ir_response"] == "gamma"
+    assert protocol_values("original") == v8 and ORIGINAL["environment"] == v8["environment"]
     # "paper" names the defaults of every key any version sets
     paper = protocol_values("paper")["environment"]
     assert (paper["drive_model"], paper["damping"], paper["schedule"], paper["drive_dead_band"],
@@ -176,9 +180,10 @@ def test_the_versions_of_the_original_bundle():
     assert protocol_values("paper")["substrate"]["bearings"] == "atan2"
     assert protocol_values("paper")["environment"]["colour_response"] == "nearer"
     assert protocol_values("paper")["environment"]["block_sighting"] == "cone"
+    assert protocol_values("paper")["environment"]["bottom_response"] == "linear"
 
 
-@pytest.mark.parametrize("version", [1, 2, 3, 4, 5, 6, 7])
+@pytest.mark.parametrize("version", [1, 2, 3, 4, 5, 6, 7, 8])
 def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path, version):
     exp = load_experiment(experiment(tmp_path, body=f'protocol = "original"\nprotocol_version = {version}'))
     saved = exp.to_dict()
@@ -192,6 +197,8 @@ def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path,
         ("atan" if version >= 5 else "atan2")
     assert again.world_config().colour_response == ("farther" if version >= 6 else "nearer")
     assert again.world_config().block_sighting == ("rays" if version >= 7 else "cone")
+    assert (again.world_config().ir_response, again.world_config().bottom_response) == \
+        (("khepera", "khepera") if version >= 8 else ("gamma", "linear"))
 
 
 @pytest.mark.parametrize("folder, version", [("original-S1-2018", 1), ("original-S1-elite02", 1),
@@ -217,8 +224,8 @@ def test_the_five_schedule_record_is_the_s1_original_preset():
 
 
 @pytest.mark.parametrize("body, needle", [
-    ('protocol = "original"\nprotocol_version = 8', "[experiment] protocol_version=8; allowed for protocol = "
-                                                     "'original': [1, 2, 3, 4, 5, 6, 7]"),
+    ('protocol = "original"\nprotocol_version = 9', "[experiment] protocol_version=9; allowed for protocol = "
+                                                     "'original': [1, 2, 3, 4, 5, 6, 7, 8]"),
     ('protocol = "original"\nprotocol_version = true', "protocol_version=True; allowed for protocol = 'original'"),
     ('protocol = "paper"\nprotocol_version = 2', "[experiment] protocol_version=2; allowed for protocol = 'paper': [1]"),
     ("protocol_version = 2", "[experiment] protocol_version=2 without a protocol; allowed: with protocol"),
@@ -362,9 +369,10 @@ def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_pa
     assert len(whole) == 4 and part == whole
     saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
     assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0
-    assert saved["protocol_version"] == 7 and saved["truncation"] == saved["weights"] == "encog"
+    assert saved["protocol_version"] == 8 and saved["truncation"] == saved["weights"] == "encog"
     assert saved["environment"]["schedule"] == "shuffled" and saved["substrate"]["bearings"] == "atan"
     assert saved["environment"]["colour_response"] == "farther" and saved["environment"]["block_sighting"] == "rays"
+    assert saved["environment"]["ir_response"] == saved["environment"]["bottom_response"] == "khepera"
     shutil.rmtree(tmp_path / "part")
 
 
@@ -594,7 +602,7 @@ def _recording_compare(seen: list):
 
 def test_compare_runs_in_the_protocols_world(tmp_path, monkeypatch, capsys):
     """gathering-compare --protocol original compares in the original world (zone 4 deep, centre
-    box, Khepera-like IR), the default in the paper's; a champion made in another world is named."""
+    box, the Khepera curve), the default in the paper's; a champion made in another world is named."""
     from evolution import compare as compare_module
     from evolution.policies.base import Policy
 
@@ -605,7 +613,7 @@ def test_compare_runs_in_the_protocols_world(tmp_path, monkeypatch, capsys):
         assert compare_module.compare_main(["--policy", "wander", "--episodes", "1", "--protocol", protocol,
                                             "--out", str(tmp_path / out)]) == 0
     original, paper = seen
-    assert (original["zone_depth"], original["pickup_box"], original["ir_response"]) == (4.0, "centre", "gamma")
+    assert (original["zone_depth"], original["pickup_box"], original["ir_response"]) == (4.0, "centre", "khepera")
     assert (paper["zone_depth"], paper["pickup_box"], paper["ir_response"]) == (8.0, "front", "linear")
     assert "original protocol" in (tmp_path / "o" / "compare.md").read_text()
 
@@ -901,15 +909,15 @@ def test_the_colour_note_and_the_version_6_run():
 
 
 def test_the_sighting_note_and_the_version_7_run():
-    """The newest bundle's runs say at their start that blocks are seen along three rays; the
-    committed version-7 run is the S1-original preset key for key and differs from the version-6
-    run by the block sighting alone."""
+    """Version 7's runs say at their start that blocks are seen along three rays; the committed
+    version-7 run is the S1-original preset at version 7 key for key and differs from the
+    version-6 run by the block sighting alone."""
     from dataclasses import replace
 
     from evolution.run.trainer import protocol_notes
 
     path, overrides = resolve_preset("S1-original")
-    exp = load_experiment(path, overrides)
+    exp = load_experiment(path, {**(overrides or {}), "protocol_version": 7})
     assert exp.world_config().block_sighting == "rays"
     assert any("block_sighting = rays" in n for n in protocol_notes(exp))
     assert any("block_sighting = rays" in n for n in protocol_notes(replace(exp, method="neat-m")))
@@ -923,6 +931,32 @@ def test_the_sighting_note_and_the_version_7_run():
     theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
     assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
     assert mine["environment"] == theirs["environment"] | {"block_sighting": "rays"}
+
+
+def test_the_khepera_note_and_the_version_8_run():
+    """The newest bundle's runs say at their start that the infrared and bottom sensors read the
+    original's Khepera curve; the committed version-8 run is the S1-original preset key for key
+    and differs from the version-7 run by the two curves alone."""
+    from dataclasses import replace
+
+    from evolution.run.trainer import protocol_notes
+
+    path, overrides = resolve_preset("S1-original")
+    exp = load_experiment(path, overrides)
+    assert (exp.world_config().ir_response, exp.world_config().bottom_response) == ("khepera", "khepera")
+    note = [n for n in protocol_notes(exp) if "Khepera curve" in n]
+    assert len(note) == 1 and "ir_response = khepera, bottom_response = khepera" in note[0]
+    assert any("Khepera curve" in n for n in protocol_notes(replace(exp, method="neat-m")))
+    v7 = load_experiment(path, {**(overrides or {}), "protocol_version": 7})
+    assert not any("Khepera curve" in n for n in protocol_notes(v7))
+    drop = ("name", "source", "protocol", "protocol_version")
+    record = load_experiment(EVIDENCE / "original-S1-v8" / "experiment.toml")
+    mine = {k: v for k, v in record.to_dict().items() if k not in drop}
+    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
+    before = load_experiment(EVIDENCE / "original-S1-v7" / "experiment.toml")
+    theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
+    assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
+    assert mine["environment"] == theirs["environment"] | {"ir_response": "khepera", "bottom_response": "khepera"}
 
 
 def test_a_one_layout_run_refuses_a_layout_seed_of_its_own(tmp_path):

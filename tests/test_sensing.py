@@ -204,6 +204,44 @@ def test_bottom_sensor_over_and_near_the_zone():
     np.testing.assert_allclose(got[:, 0], [1.0, 0.5, 0.0])
 
 
+def _khepera(x):
+    """The original's curve from scipy's Gamma(2.5, scale 2) density (independent of gathering_env)."""
+    from scipy.stats import gamma
+
+    return min(6.64 * gamma.pdf(x, 2.5, scale=2.0), 1.0)
+
+
+def test_ir_khepera_response_is_the_originals_gamma_density():
+    """``ir_response = "khepera"``: the density at 200 d / R; range 2, so x = 100 d."""
+    b = bank([SensorSpec("infrared", 0.0, 0.0, 2.0, math.pi / 3)], ir_response="khepera")
+    me = [(20, 20, 0.0), FAR, FAR]
+    for d in (0.0, 0.01, 0.03, 0.1, 0.2, 1.5):                # block face d ahead of the mount
+        got = read(b, me, [(20.15 + d + 0.2, 20, 0.0)])[0, 0]
+        assert got == pytest.approx(_khepera(100 * d), abs=1e-6), d
+    assert _khepera(3.0) == 1.0 and _khepera(0.0) == 0.0 and _khepera(10.0) == pytest.approx(0.18814, abs=1e-5)
+    assert read(b, me, [(5, 35, 0.0)])[0, 0] == 0.0              # nothing in range
+    wall = read(b, [(39.75, 20, 0.0), FAR, FAR], [(5, 35, 0.0)])[0, 0]
+    assert wall == pytest.approx(_khepera(100 * 0.1), abs=1e-6)  # the east wall 0.1 ahead
+
+
+def test_bottom_khepera_reads_the_front_on_or_off():
+    """``bottom_response = "khepera"``: a disc 0.95 r = 0.1425 ahead of the centre, read at
+    1000 (d + 0.0025), d along x first, while it overlaps the zone (x 10..30, y 0..8)."""
+    b = bank([SensorSpec("bottom")], bottom_response="khepera")
+    robots = [(20, 8.1, -math.pi / 2),      # front at y = 7.9575: over the zone
+              (20, 8.1, math.pi / 2),       # front 0.2425 beyond it: off (linear would read 0.9)
+              (20, 8.01, 0.0),              # front 0.01 beyond the north edge
+              (29.8625, 8.02, 0.0),         # front 0.005 beyond the east edge and 0.02 north
+              (20, 7.9175, math.pi / 2)]    # centre over the zone, front 0.06 beyond: the disc is clear
+    got = read(b, robots, [(35, 35, 0.0)])[:, 0]
+    want = [_khepera(2.5), 0.0, _khepera(12.5), _khepera(7.5), 0.0]
+    np.testing.assert_allclose(got, want, atol=1e-6)
+    assert got[4] == 0.0 < _khepera(1000 * 0.0625)     # exactly 0 once the disc leaves the zone
+    assert _khepera(2.5) == pytest.approx(1.0, abs=1e-5) and _khepera(7.5) > 0.4 > 0.01 > _khepera(22.5)
+    linear = read(bank([SensorSpec("bottom")]), robots, [(35, 35, 0.0)])[:, 0]
+    np.testing.assert_allclose(linear, [0.9, 0.9, 0.99, 0.98, 1.0], atol=1e-6)   # the centre, either way it faces
+
+
 def test_ir_gamma_response():
     b = bank([IR], ir_response="gamma", ir_gamma=2.0)
     got = read(b, [(20, 20, 0.0), FAR, FAR], [(21.35, 20, 0.0)])

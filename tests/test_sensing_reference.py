@@ -93,12 +93,31 @@ def _rays_distance(mount, axis, s, centre, half, angle):
     return None
 
 
+def _khepera(x):
+    from scipy.stats import gamma
+
+    return min(6.64 * gamma.pdf(x, 2.5, scale=2.0), 1.0)
+
+
 def reference_read(morph, cfg, robot_pos, robot_angle, block_pos, block_angle, block_half, block_need):
     n = len(robot_pos)
     out = np.zeros((n, len(morph)))
     zx0, zy0, zx1, zy1 = cfg.zone_rect
     for i in range(n):
         for j, s in enumerate(morph):
+            if s.type == "bottom" and cfg.bottom_response == "khepera":
+                # the original's disc ahead of the centre, by its own case analysis
+                fx = robot_pos[i][0] + 0.95 * cfg.robot_radius * math.cos(robot_angle[i])
+                fy = robot_pos[i][1] + 0.95 * cfg.robot_radius * math.sin(robot_angle[i])
+                if zx0 <= fx <= zx1 and zy0 <= fy <= zy1:
+                    d = 0.0
+                elif fx < zx0 or fx > zx1:
+                    d = zx0 - fx if fx < zx0 else fx - zx1
+                else:
+                    d = zy0 - fy if fy < zy0 else fy - zy1
+                gap = math.hypot(max(zx0 - fx, 0, fx - zx1), max(zy0 - fy, 0, fy - zy1))
+                out[i, j] = _khepera(1000 * (d + 0.0025)) if gap < 0.05 else 0.0
+                continue
             if s.type == "bottom":
                 dx = max(zx0 - robot_pos[i][0], 0, robot_pos[i][0] - zx1)
                 dy = max(zy0 - robot_pos[i][1], 0, robot_pos[i][1] - zy1)
@@ -140,7 +159,9 @@ def reference_read(morph, cfg, robot_pos, robot_angle, block_pos, block_angle, b
                 continue
             d, kind, _ = min(seen, key=lambda t: (t[0], {"block": 0, "wall": 1, "robot": 2}[t[1]]))
             close = 1 - d / s.range
-            if s.type == "infrared":
+            if s.type == "infrared" and cfg.ir_response == "khepera":
+                out[i, j] = _khepera(200 * d / s.range)
+            elif s.type == "infrared":
                 out[i, j] = close
             elif s.type == "ultrasonic":
                 out[i, j] = min(close / 0.95, 1.0)
@@ -174,18 +195,20 @@ def scenes(draw):
     size = draw(st.sampled_from([3.0, 6.0, 40.0]))
     colour = draw(st.sampled_from(["nearer", "farther"]))
     sighting = draw(st.sampled_from(["cone", "rays"]))
-    return morph, n, b, seed, size, colour, sighting
+    khepera = draw(st.booleans())
+    return morph, n, b, seed, size, colour, sighting, khepera
 
 
 @settings(max_examples=150, deadline=None)
 @given(scenes())
 def test_kernel_matches_reference(scene):
-    morph, n, b, seed, size, colour, sighting = scene
+    morph, n, b, seed, size, colour, sighting, khepera = scene
     rng = np.random.default_rng(seed)
     cfg = WorldConfig.from_kwargs(environment=None, block_counts=(max(b, 1), 0, 0), num_robots=n,
                                   arena_width=size, arena_height=size, zone_width=size / 2,
                                   zone_depth=size / 5, colour_response=colour,
-                                  block_sighting=sighting)
+                                  block_sighting=sighting, ir_response="khepera" if khepera else "linear",
+                                  bottom_response="khepera" if khepera else "linear")
     robot_pos = rng.uniform(0.2, size - 0.2, (n, 2))
     robot_angle = rng.uniform(-math.pi, math.pi, n)
     block_pos = rng.uniform(0.5, size - 0.5, (b, 2))

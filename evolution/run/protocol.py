@@ -30,7 +30,10 @@ key                           paper (default)     original
                                                   (``evolution.reproduction.breeding``)
 ``[environment] zone_depth``  8                   4 (zone 20 x 4)
 ``[environment] pickup_box``  ``"front"``         ``"centre"``, 0.1 forward x 0.2 across
-``[environment] ir_response`` ``"linear"``        ``"gamma"`` (the Khepera-like curve)
+``[environment] ir_response`` ``"linear"``        ``"gamma"`` (a steeper curve; versions 1-7),
+                                                  ``"khepera"`` (the original's curve, version 8)
+``[environment]               ``"linear"``        ``"khepera"`` (version 8): the original's bottom
+bottom_response``                                 sensor, on/off at the robot's front
 ``[environment]               ``"nearer"``        ``"farther"``: the colour reading rises with
 colour_response``                                 distance (block 0.5 + d/2R, wall d/2R)
 ``[environment]               ``"cone"``          ``"rays"``: a cone sensor sees a block only
@@ -84,10 +87,16 @@ newest one whose keys it holds with the same values (``saved_version``). The ori
    "farther"``): its colour sensor read a block as 0.5 + d / 2R and a wall as d / 2R (d the
    distance, R the range), rising with distance, where versions 1-5 read 1 - d / R in its place
    (nearer = higher); a wall at contact then reads 0, as nothing does.
-7. (2026-12, the newest) adds the 2018 simulator's block sighting (``[environment]
+7. (2026-12) adds the 2018 simulator's block sighting (``[environment]
    block_sighting = "rays"``): its cone sensors find a block (a Box2D polygon) by three ray casts,
    the axis and the two cone edges, so a block lying in the cone between them is unseen, where
    versions 1-6 saw any block whose nearest point lies in the cone.
+8. (2026-12, the newest) adds the 2018 simulator's Khepera proximity curve (``gathering_env.khepera``)
+   for the infrared sensor (``ir_response = "khepera"``: a Gamma density, 0 at contact, 1 at
+   1.3-1.8 % of the range, nearly 0 beyond 9 %, where versions 1-7 used (1 - d/R) ** 3, which
+   they took for it) and for the bottom sensor (``bottom_response = "khepera"``: a disc ahead of
+   the centre, on over the zone and off within about 0.01 of it, where versions 1-7 read the
+   centre with a 1-unit falloff).
 
 ``protocol = "paper"`` names the defaults (one version). A file that names a protocol and sets
 one of its keys to another value is refused (``ExperimentError`` naming the file and key);
@@ -127,6 +136,10 @@ ORIGINAL_COLOUR = {"colour_response": "farther"}
 #: The 2018 simulator's block sighting (version 7; ``gathering_env.reference.sensing.ray_sighting``).
 ORIGINAL_SIGHTING = {"block_sighting": "rays"}
 
+#: The 2018 simulator's Khepera proximity curve for the infrared and bottom sensors (version 8;
+#: ``gathering_env.khepera``).
+ORIGINAL_KHEPERA = {"ir_response": "khepera", "bottom_response": "khepera"}
+
 #: Protocol name -> version -> {section: {key: value}}; the "paper" values are the defaults of
 #: the dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``), filled in
 #: by ``protocol_values``.
@@ -151,6 +164,10 @@ BUNDLES: dict[str, dict[int, dict[str, dict[str, Any]]]] = {
             "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE, **ORIGINAL_COLOUR,
                             **ORIGINAL_SIGHTING},
             "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
+        8: {"experiment": {**_METHOD, **ORIGINAL_BREEDING},
+            "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE, **ORIGINAL_COLOUR,
+                            **ORIGINAL_SIGHTING, **ORIGINAL_KHEPERA},
+            "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
     },
     "paper": {1: {}},
 }
@@ -169,7 +186,7 @@ DESCRIPTIONS = {
     "paper": "the paper's text (the defaults)",
     "original": "the 2018 Java code that produced the published figures: one layout per run, ratchet on the best "
                 "genome, Encog's truncation and link weights, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its "
-                "sensor bearings (all on the front half), its colour reading (rising with distance) and block sighting (three rays), its eq. 2, its "
+                "sensor bearings (all on the front half), its colour reading (rising with distance), block sighting (three rays) and Khepera curve (infrared, bottom), its eq. 2, its "
                 "physics (mass friction, bouncing contacts) and its robot on its shuffled schedule",
 }
 

@@ -95,6 +95,10 @@ def protocol_notes(exp: Experiment) -> list[str]:
     if exp.environment.get("block_sighting") == "rays":
         notes.append(f"{exp.name}: the original's block sighting (block_sighting = rays): a sensor sees a block only "
                      "along its axis and its two cone edges (gathering_env.reference.sensing)")
+    if exp.environment.get("ir_response") == "khepera" or exp.environment.get("bottom_response") == "khepera":
+        which = [k for k in ("ir_response", "bottom_response") if exp.environment.get(k) == "khepera"]
+        notes.append(f"{exp.name}: the original's Khepera curve ({', '.join(f'{k} = khepera' for k in which)}): "
+                     "infrared near-contact, bottom on/off at the robot's front (gathering_env.khepera)")
     return notes
 
 

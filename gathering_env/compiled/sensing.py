@@ -10,12 +10,25 @@ import math
 import numpy as np
 from numba import njit
 
+from ..khepera import (
+    BOTTOM_AHEAD,
+    BOTTOM_HEIGHT,
+    BOTTOM_RADIUS,
+    GAIN,
+    MM,
+    NORM,
+    REFERENCE_RANGE,
+    SCALE,
+    SHAPE,
+)
 from .tables import (
     BOTTOM,
     CAMERA,
     F_BLOCK_RAYS,
+    F_BOTTOM_KHEPERA,
     F_COLOUR_FARTHER,
     F_IR_GAMMA,
+    F_IR_KHEPERA,
     IR,
     P_ARENA_H,
     P_ARENA_W,
@@ -65,6 +78,12 @@ def _wall_distance(mx, my, hx, hy, cos_half, sin_half, width, height):
             if dist < best:
                 best = dist
     return best
+
+
+@njit(cache=True)
+def _khepera_curve(x):
+    """``gathering_env.khepera.curve`` for one x."""
+    return min(GAIN * NORM * x ** (SHAPE - 1.0) * math.exp(-x / SCALE), 1.0)
 
 
 @njit(cache=True)
@@ -126,6 +145,8 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
     use_gamma = flags[F_IR_GAMMA] != 0
     farther = flags[F_COLOUR_FARTHER] != 0
     rays = flags[F_BLOCK_RAYS] != 0
+    ir_khepera = flags[F_IR_KHEPERA] != 0
+    bottom_khepera = flags[F_BOTTOM_KHEPERA] != 0
     gamma = params[P_IR_GAMMA]
     max_range = 0.0
     has_cone = False
@@ -234,9 +255,16 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
                 rng = table[s, T_RANGE]
                 value = 0.0
                 if kind == BOTTOM:
-                    dx = max(max(params[P_ZX0] - px, px - params[P_ZX1]), 0.0)
-                    dy = max(max(params[P_ZY0] - py, py - params[P_ZY1]), 0.0)
-                    value = min(max(1.0 - math.hypot(dx, dy) / params[P_FALLOFF], 0.0), 1.0)
+                    bx, by = px, py
+                    if bottom_khepera:
+                        bx = px + BOTTOM_AHEAD * r * math.cos(a)
+                        by = py + BOTTOM_AHEAD * r * math.sin(a)
+                    dx = max(max(params[P_ZX0] - bx, bx - params[P_ZX1]), 0.0)
+                    dy = max(max(params[P_ZY0] - by, by - params[P_ZY1]), 0.0)
+                    if not bottom_khepera:
+                        value = min(max(1.0 - math.hypot(dx, dy) / params[P_FALLOFF], 0.0), 1.0)
+                    elif math.hypot(dx, dy) < BOTTOM_RADIUS:
+                        value = _khepera_curve(MM * ((dx if dx > 0.0 else dy) + BOTTOM_HEIGHT))
                 elif kind == CAMERA:
                     team = robots_seen[s] + 1.0
                     if need_seen[s] > 0.0 and team <= need_seen[s]:
@@ -247,7 +275,10 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
                     d_any = min(min(d_robot[s], d_block[s]), d_wall)
                     closeness = max(1.0 - d_any * table[s, T_INV_RANGE], 0.0)
                     if kind == IR:
-                        value = closeness ** gamma if use_gamma else closeness
+                        if not ir_khepera:
+                            value = closeness ** gamma if use_gamma else closeness
+                        elif d_any < rng:
+                            value = _khepera_curve(MM * REFERENCE_RANGE * d_any * table[s, T_INV_RANGE])
                     elif kind == US:
                         value = min(closeness / 0.95, 1.0)
                     elif d_any < rng:  # colour

@@ -19,7 +19,8 @@ T_TYPE, T_BEARING, T_OFFSET, T_RANGE, T_COS_HALF, T_SIN_HALF, T_INV_RANGE = rang
  P_MAX_SPEED, P_ZONE_CX, P_ZONE_CY, P_AVOID_DIST, P_BOX_W, P_BOX_D, P_REACH, P_TOTAL_VALUE,
  P_MAX_CYCLES, P_BOX_OFFSET, P_DEAD_BAND, P_MASS, P_MOMENT, P_SUBSTEPS, P_KEEP, P_SPIN_LIMIT) = range(26)
 # Entries of the integer flag vector.
-F_IR_GAMMA, F_AVOIDANCE, F_PICKUP, F_FORCE_DRIVE, F_COLOUR_FARTHER, F_BLOCK_RAYS = range(6)
+(F_IR_GAMMA, F_AVOIDANCE, F_PICKUP, F_FORCE_DRIVE, F_COLOUR_FARTHER, F_BLOCK_RAYS, F_IR_KHEPERA,
+ F_BOTTOM_KHEPERA) = range(8)
 # Event kinds reported by ``settle`` (rows of the int event table: kind, world, robot, block, slot).
 EV_ATTACH, EV_RELEASE = 1, 2
 
@@ -49,5 +50,6 @@ def world_params(config) -> tuple[np.ndarray, np.ndarray]:
     ], dtype=np.float64)
     flags = np.array([config.ir_response == "gamma", config.collision_avoidance, config.pickup_heuristic,
                       config.drive_model == "force", config.colour_response == "farther",
-                      config.block_sighting == "rays"], dtype=np.int64)
+                      config.block_sighting == "rays", config.ir_response == "khepera",
+                      config.bottom_response == "khepera"], dtype=np.int64)
     return params, flags

@@ -19,7 +19,8 @@ the mount lies inside it (``ray_sighting``).
 
 Readings, all in [0, 1] (d = distance to the closest seen object, R = range):
 
-* infrared: ``1 - d/R`` (or ``(1 - d/R) ** gamma``), 0 when nothing is seen.
+* infrared: ``1 - d/R`` (or ``(1 - d/R) ** gamma``, or the original's Khepera curve of
+  ``200 d/R``, ``gathering_env.khepera``), 0 when nothing is seen.
 * ultrasonic: 1 for ``d <= 0.05 R``, then linear down to 0 at ``d = R``.
 * colour: closest object a block -> ``0.5 + 0.5 (1 - d/R)`` in (0.5, 1];
   a wall -> ``0.5 (1 - d/R)`` in (0, 0.5]; a robot or nothing -> 0. With
@@ -28,13 +29,15 @@ Readings, all in [0, 1] (d = distance to the closest seen object, R = range):
 * camera: with n robots seen, R' = n + 1 and Q = sum of robots needed by the blocks seen:
   ``R'/Q`` if Q > 0 and R' <= Q, else 0. Walls are not seen by the camera.
 * bottom: 1 with the robot's centre over the zone, falling linearly to 0 at
-  ``bottom_falloff`` units outside it.
+  ``bottom_falloff`` units outside it (or, ``bottom_response = "khepera"``, the original's disc
+  ahead of the centre through the Khepera curve, ``gathering_env.khepera``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from .. import khepera as khepera_curves
 from ..config import WorldConfig
 from ..sensors import TYPE_CODES, Morphology
 
@@ -124,15 +127,25 @@ class SensorBank:
         if self._has_cone:
             out[:, self._cone_idx] = self._read_cones(robot_pos, robot_angle, block_pos, block_angle)
         if self._bottom_idx.size:
-            out[:, self._bottom_idx] = self._read_bottom(robot_pos)[:, None]
+            out[:, self._bottom_idx] = self._read_bottom(robot_pos, robot_angle)[:, None]
         return out
 
-    def _read_bottom(self, robot_pos: np.ndarray) -> np.ndarray:
-        x0, y0, x1, y1 = self.config.zone_rect
-        dx = np.maximum(np.maximum(x0 - robot_pos[:, 0], robot_pos[:, 0] - x1), 0.0)
-        dy = np.maximum(np.maximum(y0 - robot_pos[:, 1], robot_pos[:, 1] - y1), 0.0)
+    def _read_bottom(self, robot_pos: np.ndarray, robot_angle: np.ndarray) -> np.ndarray:
+        cfg = self.config
+        x0, y0, x1, y1 = cfg.zone_rect
+        khepera = cfg.bottom_response == "khepera"
+        px, py = robot_pos[:, 0], robot_pos[:, 1]
+        if khepera:
+            ahead = khepera_curves.BOTTOM_AHEAD * cfg.robot_radius
+            px, py = px + ahead * np.cos(robot_angle), py + ahead * np.sin(robot_angle)
+        dx = np.maximum(np.maximum(x0 - px, px - x1), 0.0)
+        dy = np.maximum(np.maximum(y0 - py, py - y1), 0.0)
         outside = np.hypot(dx, dy)
-        return np.clip(1.0 - outside / self.config.bottom_falloff, 0.0, 1.0)
+        if khepera:
+            d = np.where(dx > 0.0, dx, dy)   # along x first, as the original
+            reading = khepera_curves.curve(khepera_curves.MM * (d + khepera_curves.BOTTOM_HEIGHT))
+            return np.where(outside < khepera_curves.BOTTOM_RADIUS, reading, 0.0)
+        return np.clip(1.0 - outside / cfg.bottom_falloff, 0.0, 1.0)
 
     def _read_cones(self, robot_pos, robot_angle, block_pos, block_angle) -> np.ndarray:
         """(N, C) readings of the cone sensors.
@@ -202,7 +215,11 @@ class SensorBank:
             d_any = np.minimum(np.minimum(d_robot, d_block), d_wall)
             closeness = np.maximum(1.0 - d_any * self._inv_range_c, 0.0)   # 0 when nothing seen
             if IR in present:
-                ir = closeness ** cfg.ir_gamma if cfg.ir_response == "gamma" else closeness
+                if cfg.ir_response == "khepera":
+                    scaled = khepera_curves.MM * khepera_curves.REFERENCE_RANGE * self._inv_range_c
+                    ir = np.where(d_any < rng, khepera_curves.curve(np.where(d_any < rng, d_any, 0.0) * scaled), 0.0)
+                else:
+                    ir = closeness ** cfg.ir_gamma if cfg.ir_response == "gamma" else closeness
                 readings = np.where(self._is[IR], ir, readings)
             if US in present:
                 readings = np.where(self._is[US], np.minimum(closeness / 0.95, 1.0), readings)
