@@ -183,6 +183,11 @@ class WorldConfig:
     block, in that order, gives the distance (its projection on the axis), else the block is
     unseen unless the mount lies inside it (distance 0); a block whose nearest point is out of
     range is unseen either way. Robots and walls are seen over the whole cone in both."""
+    wall_distance: str = "nearest"
+    """The distance at which a cone sensor reads a wall it sees (one whose nearest point in the
+    cone lies within range). 'nearest': that nearest point's. 'original': the 2018 simulator's
+    line formulas (``gathering_env.reference.sensing.original_wall_distance``), which mix the
+    sensor's frame with the world's and so give another distance, often beyond the range."""
     bottom_falloff: float = 1.0
     """Distance outside the zone (units) over which the bottom sensor falls from 1 to 0."""
     bottom_response: str = "linear"
@@ -309,6 +314,8 @@ class WorldConfig:
             raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma', 'khepera'")
         if self.bottom_response not in ("linear", "khepera"):
             raise ValueError(f"bottom_response={self.bottom_response!r}; allowed: 'linear', 'khepera'")
+        if self.wall_distance not in ("nearest", "original"):
+            raise ValueError(f"wall_distance={self.wall_distance!r}; allowed: 'nearest', 'original'")
         if self.block_sighting not in ("cone", "rays"):
             raise ValueError(f"block_sighting={self.block_sighting!r}; allowed: 'cone', 'rays'")
         if self.colour_response not in ("nearer", "farther"):

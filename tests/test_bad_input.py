@@ -64,6 +64,7 @@ def test_too_many_sensors_and_bad_dicts():
     (dict(colour_response="closer"), "colour_response='closer'"),
     (dict(block_sighting="beams"), "block_sighting='beams'; allowed: 'cone', 'rays'"),
     (dict(bottom_response="sonar"), "bottom_response='sonar'; allowed: 'linear', 'khepera'"),
+    (dict(wall_distance="true"), "wall_distance='true'; allowed: 'nearest', 'original'"),
     (dict(ground_friction="coulomb"), "ground_friction='coulomb'; allowed: 'threshold', 'mass'"),
     (dict(robot_restitution=1.2), "robot_restitution=1.2 out of range; allowed: [0.0, 1.0]"),
     (dict(drive_dead_band=1.0), "drive_dead_band=1.0 out of range; allowed: [0.0, 1.0)"),

@@ -187,7 +187,8 @@ def _episode(kernel: str, steps: int, morphology: Morphology, seed: int, **world
     dict(SMALL, drive_model="force", physics_substeps=3, collision_avoidance=True),
     dict(SMALL, ground_friction="mass", robot_restitution=1.0, block_restitution=0.4, wall_restitution=1.0,
          drive_model="force", damping=0.1, schedule="shuffled"),
-    dict(SMALL, colour_response="farther", block_sighting="rays"),
+    dict(SMALL, colour_response="farther", block_sighting="rays", ir_response="khepera", bottom_response="khepera",
+         wall_distance="original"),
 ], ids=["small", "avoidance", "weld-in-place", "gamma-substeps", "env3", "centre-box", "original-box",
         "original-physics", "force-drive", "force-drive-substeps", "force-drive-shuffled", "original-sensing"])
 def test_whole_episodes_are_identical_on_both_kernels(world):

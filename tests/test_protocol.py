@@ -170,7 +170,10 @@ def test_the_versions_of_the_original_bundle():
     assert v8["experiment"] == v7["experiment"] and v8["substrate"] == v7["substrate"]
     assert v8["environment"] == v7["environment"] | {"ir_response": "khepera", "bottom_response": "khepera"}
     assert v7["environment"]["ir_response"] == "gamma"
-    assert protocol_values("original") == v8 and ORIGINAL["environment"] == v8["environment"]
+    v9 = protocol_values("original", 9)
+    assert v9["experiment"] == v8["experiment"] and v9["substrate"] == v8["substrate"]
+    assert v9["environment"] == v8["environment"] | {"wall_distance": "original"}
+    assert protocol_values("original") == v9 and ORIGINAL["environment"] == v9["environment"]
     # "paper" names the defaults of every key any version sets
     paper = protocol_values("paper")["environment"]
     assert (paper["drive_model"], paper["damping"], paper["schedule"], paper["drive_dead_band"],
@@ -181,9 +184,10 @@ def test_the_versions_of_the_original_bundle():
     assert protocol_values("paper")["environment"]["colour_response"] == "nearer"
     assert protocol_values("paper")["environment"]["block_sighting"] == "cone"
     assert protocol_values("paper")["environment"]["bottom_response"] == "linear"
+    assert protocol_values("paper")["environment"]["wall_distance"] == "nearest"
 
 
-@pytest.mark.parametrize("version", [1, 2, 3, 4, 5, 6, 7, 8])
+@pytest.mark.parametrize("version", [1, 2, 3, 4, 5, 6, 7, 8, 9])
 def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path, version):
     exp = load_experiment(experiment(tmp_path, body=f'protocol = "original"\nprotocol_version = {version}'))
     saved = exp.to_dict()
@@ -199,6 +203,7 @@ def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path,
     assert again.world_config().block_sighting == ("rays" if version >= 7 else "cone")
     assert (again.world_config().ir_response, again.world_config().bottom_response) == \
         (("khepera", "khepera") if version >= 8 else ("gamma", "linear"))
+    assert again.world_config().wall_distance == ("original" if version >= 9 else "nearest")
 
 
 @pytest.mark.parametrize("folder, version", [("original-S1-2018", 1), ("original-S1-elite02", 1),
@@ -224,8 +229,8 @@ def test_the_five_schedule_record_is_the_s1_original_preset():
 
 
 @pytest.mark.parametrize("body, needle", [
-    ('protocol = "original"\nprotocol_version = 9', "[experiment] protocol_version=9; allowed for protocol = "
-                                                     "'original': [1, 2, 3, 4, 5, 6, 7, 8]"),
+    ('protocol = "original"\nprotocol_version = 10', "[experiment] protocol_version=10; allowed for protocol = "
+                                                     "'original': [1, 2, 3, 4, 5, 6, 7, 8, 9]"),
     ('protocol = "original"\nprotocol_version = true', "protocol_version=True; allowed for protocol = 'original'"),
     ('protocol = "paper"\nprotocol_version = 2', "[experiment] protocol_version=2; allowed for protocol = 'paper': [1]"),
     ("protocol_version = 2", "[experiment] protocol_version=2 without a protocol; allowed: with protocol"),
@@ -369,10 +374,11 @@ def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_pa
     assert len(whole) == 4 and part == whole
     saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
     assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0
-    assert saved["protocol_version"] == 8 and saved["truncation"] == saved["weights"] == "encog"
+    assert saved["protocol_version"] == 9 and saved["truncation"] == saved["weights"] == "encog"
     assert saved["environment"]["schedule"] == "shuffled" and saved["substrate"]["bearings"] == "atan"
     assert saved["environment"]["colour_response"] == "farther" and saved["environment"]["block_sighting"] == "rays"
     assert saved["environment"]["ir_response"] == saved["environment"]["bottom_response"] == "khepera"
+    assert saved["environment"]["wall_distance"] == "original"
     shutil.rmtree(tmp_path / "part")
 
 
@@ -934,15 +940,15 @@ def test_the_sighting_note_and_the_version_7_run():
 
 
 def test_the_khepera_note_and_the_version_8_run():
-    """The newest bundle's runs say at their start that the infrared and bottom sensors read the
-    original's Khepera curve; the committed version-8 run is the S1-original preset key for key
-    and differs from the version-7 run by the two curves alone."""
+    """Version 8's runs say at their start that the infrared and bottom sensors read the
+    original's Khepera curve; the committed version-8 run is the S1-original preset at version 8
+    key for key and differs from the version-7 run by the two curves alone."""
     from dataclasses import replace
 
     from evolution.run.trainer import protocol_notes
 
     path, overrides = resolve_preset("S1-original")
-    exp = load_experiment(path, overrides)
+    exp = load_experiment(path, {**(overrides or {}), "protocol_version": 8})
     assert (exp.world_config().ir_response, exp.world_config().bottom_response) == ("khepera", "khepera")
     note = [n for n in protocol_notes(exp) if "Khepera curve" in n]
     assert len(note) == 1 and "ir_response = khepera, bottom_response = khepera" in note[0]
@@ -957,6 +963,31 @@ def test_the_khepera_note_and_the_version_8_run():
     theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
     assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
     assert mine["environment"] == theirs["environment"] | {"ir_response": "khepera", "bottom_response": "khepera"}
+
+
+def test_the_wall_note_and_the_version_9_run():
+    """The newest bundle's runs say at their start that walls are read at the original's
+    distances; the committed version-9 run is the S1-original preset key for key and differs
+    from the version-8 run by the wall distances alone."""
+    from dataclasses import replace
+
+    from evolution.run.trainer import protocol_notes
+
+    path, overrides = resolve_preset("S1-original")
+    exp = load_experiment(path, overrides)
+    assert exp.world_config().wall_distance == "original"
+    assert any("wall_distance = original" in n for n in protocol_notes(exp))
+    assert any("wall_distance = original" in n for n in protocol_notes(replace(exp, method="neat-m")))
+    v8 = load_experiment(path, {**(overrides or {}), "protocol_version": 8})
+    assert not any("wall_distance" in n for n in protocol_notes(v8))
+    drop = ("name", "source", "protocol", "protocol_version")
+    record = load_experiment(EVIDENCE / "original-S1-v9" / "experiment.toml")
+    mine = {k: v for k, v in record.to_dict().items() if k not in drop}
+    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
+    before = load_experiment(EVIDENCE / "original-S1-v8" / "experiment.toml")
+    theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
+    assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
+    assert mine["environment"] == theirs["environment"] | {"wall_distance": "original"}
 
 
 def test_a_one_layout_run_refuses_a_layout_seed_of_its_own(tmp_path):

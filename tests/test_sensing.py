@@ -166,6 +166,32 @@ def test_block_sighting_by_the_originals_three_rays():
     assert read(wide, me, [(21.15, 21.85, 0.0)])[0, 0] == pytest.approx(0.5 + 0.5 * (1 - 0.6 / 2))
 
 
+def test_wall_distance_original_by_hand():
+    """``wall_distance = "original"``: the 2018 formulas, worked by hand for a mount at (2, 20)
+    facing west and 0.3 rad south of it (h = (-0.95534, -0.29552)), FOV 90 degrees (g = 1),
+    range 6. The west wall's ends in the sensor's frame: (0, 40) -> v1 = (-3.99973, -19.69774),
+    (0, 0) -> v2 = (7.82107, 18.51566); m = 3.23273, c = -6.76769; y = -1 at x1 = 1.78415,
+    y = +1 at x2 = 2.40282; foot (m + 1/m) / (20 + 2/m - c) = 0.12934 < x1, so d = |(x1, -1)| =
+    2.04530, where the wall is 2 away. No other wall is in range."""
+    a = math.pi + 0.3
+    me = [(2 - 0.15 * math.cos(a), 20 - 0.15 * math.sin(a), a), FAR, FAR]
+    col = SensorSpec("colour", 0.0, 0.0, 6.0, math.pi / 2)
+    original = bank([col], wall_distance="original", colour_response="farther")
+    nearest = bank([col], colour_response="farther")
+    assert read(original, me, [(35, 5, 0.0)])[0, 0] == pytest.approx(0.5 * 2.04530 / 6, abs=2e-6)
+    assert read(nearest, me, [(35, 5, 0.0)])[0, 0] == pytest.approx(0.5 * 2.0 / 6, abs=2e-6)
+    # facing 1.2 rad north of west from (3, 20): the west wall's nearest point in the cone is
+    # 3.28 away, within range, but the formulas put it 10.90 away, beyond the range: read as a
+    # wall at full distance (0.5), where the nearest point reads 0.27
+    a = math.pi - 1.2
+    me = [(3 - 0.15 * math.cos(a), 20 - 0.15 * math.sin(a), a), FAR, FAR]
+    assert read(original, me, [(35, 5, 0.0)])[0, 0] == pytest.approx(0.5)
+    true = 3.0 / (math.cos(math.pi / 2 - 1.2) * math.cos(math.pi / 4) + math.sin(math.pi / 2 - 1.2) * math.sin(math.pi / 4))
+    assert read(nearest, me, [(35, 5, 0.0)])[0, 0] == pytest.approx(0.5 * true / 6, abs=2e-6)
+    # a block nearer than the formulas' wall is read as the block
+    assert read(original, me, [(3 + 1.2 * math.cos(a), 20 + 1.2 * math.sin(a), a)])[0, 0] > 0.5
+
+
 def test_colour_sensor_farther_rises_with_distance():
     """The original's colour reading (``colour_response = "farther"``): d/R in place of 1 - d/R."""
     col = SensorSpec("colour", 0.0, 0.0, 2.0, math.pi / 3)

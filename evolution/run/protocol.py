@@ -38,6 +38,8 @@ bottom_response``                                 sensor, on/off at the robot's 
 colour_response``                                 distance (block 0.5 + d/2R, wall d/2R)
 ``[environment]               ``"cone"``          ``"rays"``: a cone sensor sees a block only
 block_sighting``                                  along its axis and its two edges (three rays)
+``[environment]               ``"nearest"``       ``"original"`` (version 9): a wall is read at
+wall_distance``                                   the distance the 2018 formulas give
 ``[environment]               ``"threshold"``     ``"mass"``: kinetic Coulomb friction 0.1 m g
 ground_friction``                                 whatever the robots needed (docs/fidelity.md)
 ``[environment] robot_,       0, 0, 0             1, 0.4, 1 (Box2D's: a contact takes the larger)
@@ -91,12 +93,16 @@ newest one whose keys it holds with the same values (``saved_version``). The ori
    block_sighting = "rays"``): its cone sensors find a block (a Box2D polygon) by three ray casts,
    the axis and the two cone edges, so a block lying in the cone between them is unseen, where
    versions 1-6 saw any block whose nearest point lies in the cone.
-8. (2026-12, the newest) adds the 2018 simulator's Khepera proximity curve (``gathering_env.khepera``)
+8. (2026-12) adds the 2018 simulator's Khepera proximity curve (``gathering_env.khepera``)
    for the infrared sensor (``ir_response = "khepera"``: a Gamma density, 0 at contact, 1 at
    1.3-1.8 % of the range, nearly 0 beyond 9 %, where versions 1-7 used (1 - d/R) ** 3, which
    they took for it) and for the bottom sensor (``bottom_response = "khepera"``: a disc ahead of
    the centre, on over the zone and off within about 0.01 of it, where versions 1-7 read the
    centre with a 1-unit falloff).
+9. (2026-12, the newest) adds the 2018 simulator's wall distances (``wall_distance =
+   "original"``): its sensors read a wall they see at the distance its line formulas give
+   (``gathering_env.reference.sensing.original_wall_distance``), which mix the sensor's frame with
+   the world's, where versions 1-8 read the wall's nearest point in the cone.
 
 ``protocol = "paper"`` names the defaults (one version). A file that names a protocol and sets
 one of its keys to another value is refused (``ExperimentError`` naming the file and key);
@@ -140,6 +146,9 @@ ORIGINAL_SIGHTING = {"block_sighting": "rays"}
 #: ``gathering_env.khepera``).
 ORIGINAL_KHEPERA = {"ir_response": "khepera", "bottom_response": "khepera"}
 
+#: The 2018 simulator's wall distances (version 9; ``gathering_env.reference.sensing``).
+ORIGINAL_WALLS = {"wall_distance": "original"}
+
 #: Protocol name -> version -> {section: {key: value}}; the "paper" values are the defaults of
 #: the dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``), filled in
 #: by ``protocol_values``.
@@ -168,6 +177,10 @@ BUNDLES: dict[str, dict[int, dict[str, dict[str, Any]]]] = {
             "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE, **ORIGINAL_COLOUR,
                             **ORIGINAL_SIGHTING, **ORIGINAL_KHEPERA},
             "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
+        9: {"experiment": {**_METHOD, **ORIGINAL_BREEDING},
+            "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE, **ORIGINAL_COLOUR,
+                            **ORIGINAL_SIGHTING, **ORIGINAL_KHEPERA, **ORIGINAL_WALLS},
+            "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
     },
     "paper": {1: {}},
 }
@@ -186,7 +199,7 @@ DESCRIPTIONS = {
     "paper": "the paper's text (the defaults)",
     "original": "the 2018 Java code that produced the published figures: one layout per run, ratchet on the best "
                 "genome, Encog's truncation and link weights, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its "
-                "sensor bearings (all on the front half), its colour reading (rising with distance), block sighting (three rays) and Khepera curve (infrared, bottom), its eq. 2, its "
+                "sensor bearings (all on the front half), its colour reading (rising with distance), block sighting (three rays), wall distances and Khepera curve (infrared, bottom), its eq. 2, its "
                 "physics (mass friction, bouncing contacts) and its robot on its shuffled schedule",
 }
 

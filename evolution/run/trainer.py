@@ -99,6 +99,9 @@ def protocol_notes(exp: Experiment) -> list[str]:
         which = [k for k in ("ir_response", "bottom_response") if exp.environment.get(k) == "khepera"]
         notes.append(f"{exp.name}: the original's Khepera curve ({', '.join(f'{k} = khepera' for k in which)}): "
                      "infrared near-contact, bottom on/off at the robot's front (gathering_env.khepera)")
+    if exp.environment.get("wall_distance") == "original":
+        notes.append(f"{exp.name}: the original's wall distances (wall_distance = original): a wall is read at the "
+                     "distance the 2018 line formulas give, not its nearest point (gathering_env.reference.sensing)")
     return notes
 
 

@@ -29,6 +29,7 @@ from .tables import (
     F_COLOUR_FARTHER,
     F_IR_GAMMA,
     F_IR_KHEPERA,
+    F_WALL_ORIGINAL,
     IR,
     P_ARENA_H,
     P_ARENA_W,
@@ -77,6 +78,73 @@ def _wall_distance(mx, my, hx, hy, cos_half, sin_half, width, height):
             dist = perp / cos_eff
             if dist < best:
                 best = dist
+    return best
+
+
+@njit(cache=True)
+def _original_wall_distance(mx, my, hx, hy, cos_half, sin_half, width, height, rng):
+    """``gathering_env.reference.sensing.original_wall_distance`` of the nearest wall the cone
+    sees (its nearest point in the cone within ``rng``), inf if none."""
+    best = np.inf
+    g = sin_half / cos_half
+    for wall in range(4):
+        if wall == 0:
+            cos_d, sin_d, perp = -hx, abs(-hy), mx
+            ax_w, ay_w, bx_w, by_w = 0.0, 0.0, 0.0, height
+        elif wall == 1:
+            cos_d, sin_d, perp = hx, abs(hy), width - mx
+            ax_w, ay_w, bx_w, by_w = width, 0.0, width, height
+        elif wall == 2:
+            cos_d, sin_d, perp = -hy, abs(-hx), my
+            ax_w, ay_w, bx_w, by_w = 0.0, 0.0, width, 0.0
+        else:
+            cos_d, sin_d, perp = hy, abs(hx), height - my
+            ax_w, ay_w, bx_w, by_w = 0.0, height, width, height
+        perp = max(perp, 0.0)
+        cos_eff = 1.0 if cos_d >= cos_half else cos_d * cos_half + sin_d * sin_half
+        if cos_eff <= 1e-9 or perp / cos_eff >= rng:
+            continue
+        ax = (ax_w - mx) * hx + (ay_w - my) * hy
+        ay = (ay_w - my) * hx - (ax_w - mx) * hy
+        bx = (bx_w - mx) * hx + (by_w - my) * hy
+        by = (by_w - my) * hx - (bx_w - mx) * hy
+        dx = bx - ax
+        dy = by - ay
+        if ay <= by:
+            v1x, v1y, v2x, v2y = ax, ay, bx, by
+        else:
+            v1x, v1y, v2x, v2y = bx, by, ax, ay
+        if abs(dy) < 1e-6:
+            lx, ly = (ax, ay) if ax <= bx else (bx, by)
+            dist = math.hypot(max(ly / g, lx), ly)
+        elif abs(dx) < 1e-6:
+            u1 = max(-g * v1x, v1y)
+            u2 = min(g * v2x, v2y)
+            if u1 > 0:
+                dist = math.hypot(v1x, u1)
+            elif u2 < 0:
+                dist = math.hypot(v2x, u2)
+            else:
+                dist = v1x
+        else:
+            m = dy / dx
+            c = v1y - m * v1x
+            x1, y1 = (-g - c) / m, -g
+            x2, y2 = (g - c) / m, g
+            if v1y > y1:
+                x1, y1 = v1x, v1y
+            if v2y < y2:
+                x2, y2 = v2x, v2y
+            denominator = my + mx / m - c
+            foot = (m + 1.0 / m) / denominator if denominator != 0.0 else math.copysign(np.inf, m + 1.0 / m)
+            if foot > x2:
+                dist = math.hypot(x2, y2)
+            elif foot < x1:
+                dist = math.hypot(x1, y1)
+            else:
+                dist = math.hypot(foot, m * foot + c)
+        if dist < best:
+            best = dist
     return best
 
 
@@ -147,6 +215,7 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
     rays = flags[F_BLOCK_RAYS] != 0
     ir_khepera = flags[F_IR_KHEPERA] != 0
     bottom_khepera = flags[F_BOTTOM_KHEPERA] != 0
+    wall_original = flags[F_WALL_ORIGINAL] != 0
     gamma = params[P_IR_GAMMA]
     max_range = 0.0
     has_cone = False
@@ -270,8 +339,12 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
                     if need_seen[s] > 0.0 and team <= need_seen[s]:
                         value = team / need_seen[s]
                 else:
-                    d_wall = _wall_distance(mx[s], my[s], hx[s], hy[s], table[s, T_COS_HALF],
-                                            table[s, T_SIN_HALF], width, height)
+                    if wall_original:
+                        d_wall = _original_wall_distance(mx[s], my[s], hx[s], hy[s], table[s, T_COS_HALF],
+                                                         table[s, T_SIN_HALF], width, height, rng)
+                    else:
+                        d_wall = _wall_distance(mx[s], my[s], hx[s], hy[s], table[s, T_COS_HALF],
+                                                table[s, T_SIN_HALF], width, height)
                     d_any = min(min(d_robot[s], d_block[s]), d_wall)
                     closeness = max(1.0 - d_any * table[s, T_INV_RANGE], 0.0)
                     if kind == IR:
@@ -281,7 +354,7 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
                             value = _khepera_curve(MM * REFERENCE_RANGE * d_any * table[s, T_INV_RANGE])
                     elif kind == US:
                         value = min(closeness / 0.95, 1.0)
-                    elif d_any < rng:  # colour
+                    elif d_any < rng or (wall_original and d_any < np.inf):  # colour (an original wall may lie beyond)
                         level = 1.0 - closeness if farther else closeness
                         if d_block[s] <= d_any:
                             value = 0.5 + 0.5 * level

@@ -227,7 +227,9 @@ class SensorBank:
                 level = 1.0 - closeness if cfg.colour_response == "farther" else closeness
                 colour = np.where(d_block <= d_any, 0.5 + 0.5 * level,
                                   np.where((d_wall <= d_any) & (d_robot > d_any), 0.5 * level, 0.0))
-                readings = np.where(self._is[COLOUR] & (d_any < rng), colour, readings)
+                # a wall read at the original's distance may lie beyond the range: still seen
+                seen_any = np.isfinite(d_any) if cfg.wall_distance == "original" else d_any < rng
+                readings = np.where(self._is[COLOUR] & seen_any, colour, readings)
         if self._needs_camera:
             team = robots_seen + 1.0
             ok = (need_seen > 0) & (team <= need_seen)
@@ -251,7 +253,66 @@ class SensorBank:
         cos_eff = np.where(cos_d >= self._cos_half_w, 1.0, cos_d * self._cos_half_w + sin_d * self._sin_half_w)
         with np.errstate(divide="ignore", invalid="ignore"):
             dist = np.where(cos_eff > 1e-9, perp / cos_eff, np.inf)
+        if self.config.wall_distance == "original":
+            seen = dist < self._range_c[None, :, None]
+            cfg = self.config
+            buggy = original_wall_distance(mx[..., None], my[..., None], hx[..., None], hy[..., None],
+                                           self._cos_half_w, self._sin_half_w, _WALL_ENDS(cfg.arena_width, cfg.arena_height))
+            return np.where(seen, buggy, np.inf).min(axis=-1)
         return dist.min(axis=-1)
+
+
+def _WALL_ENDS(width, height):
+    """(4, 2, 2) end points of the walls west, east, south, north (their order in the kernels)."""
+    return np.array([[[0.0, 0.0], [0.0, height]], [[width, 0.0], [width, height]],
+                     [[0.0, 0.0], [width, 0.0]], [[0.0, height], [width, height]]])
+
+
+def original_wall_distance(mx, my, hx, hy, cos_half, sin_half, ends):
+    """The distance at which the 2018 simulator's cone sensors read each wall (arrays broadcast
+    against the walls' last axis, ``ends`` (4, 2, 2)).
+
+    In the sensor's frame (mount at the origin, axis +x, g = tan of the half-angle) it takes the
+    wall's line y = m x + c through its end points v1, v2 (v1 the lower in y) and, as its
+    ``senseEdgeFixture`` does: the points where the line reaches y = -g and y = +g (not the
+    cone's edges y = -g x and y = g x), each replaced by v1 / v2 when the wall ends before; the
+    foot x = (m + 1/m) / (c' - c) with c' = s_y + s_x / m built from the mount's *world*
+    position s; and the distance of the point at x, or of the nearer end point when x falls
+    outside them. A wall level or upright in the sensor's frame (|dy| or |dx| < 1e-6) has its
+    own rules, also the original's. The result is not the wall's distance; it may exceed the
+    range, or fall short of it."""
+    ax_w, ay_w, bx_w, by_w = ends[:, 0, 0], ends[:, 0, 1], ends[:, 1, 0], ends[:, 1, 1]
+    g = sin_half / cos_half
+    # end points in the sensor's frame
+    ax = (ax_w - mx) * hx + (ay_w - my) * hy
+    ay = (ay_w - my) * hx - (ax_w - mx) * hy
+    bx = (bx_w - mx) * hx + (by_w - my) * hy
+    by = (by_w - my) * hx - (bx_w - mx) * hy
+    dx, dy = bx - ax, by - ay
+    low = ay <= by                                   # v1: the lower end in y
+    v1x, v1y = np.where(low, ax, bx), np.where(low, ay, by)
+    v2x, v2y = np.where(low, bx, ax), np.where(low, by, ay)
+    level = np.abs(dy) < 1e-6
+    upright = ~level & (np.abs(dx) < 1e-6)
+    general = ~level & ~upright
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        m = np.where(general, dy / np.where(general, dx, 1.0), 1.0)
+        c = v1y - m * v1x
+        x1, y1 = (-g - c) / m, -g
+        x2, y2 = (g - c) / m, g
+        x1, y1 = np.where(v1y > y1, v1x, x1), np.where(v1y > y1, v1y, y1)
+        x2, y2 = np.where(v2y < y2, v2x, x2), np.where(v2y < y2, v2y, y2)
+        foot = (m + 1.0 / m) / (my + mx / m - c)
+        d_general = np.where(foot > x2, np.hypot(x2, y2),
+                             np.where(foot < x1, np.hypot(x1, y1), np.hypot(foot, m * foot + c)))
+        # level in the sensor's frame: the left end (in x), pushed to the cone's edge
+        lx, ly = np.where(ax <= bx, ax, bx), np.where(ax <= bx, ay, by)
+        d_level = np.hypot(np.maximum(ly / g, lx), ly)
+        # upright: straight ahead, or the end of the part inside the cone's edges
+        u1 = np.maximum(-g * v1x, v1y)
+        u2 = np.minimum(g * v2x, v2y)
+        d_upright = np.where(u1 > 0, np.hypot(v1x, u1), np.where(u2 < 0, np.hypot(v2x, u2), v1x))
+    return np.where(level, d_level, np.where(upright, d_upright, d_general))
 
 
 def ray_entry(ox, oy, dx, dy, half, length):
