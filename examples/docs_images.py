@@ -183,6 +183,7 @@ V4_CELLS = {
     "original-S1-v6": ("version 6 (version 5 + the original's colour reading)", "C5", "-"),
     "original-S1-v7": ("version 7 (version 6 + the original's block sighting)", "C6", "-"),
     "original-S1-v8": ("version 8 (version 7 + the original's Khepera curve)", "C7", "-"),
+    "original-S1-v9": ("version 9 (version 8 + the original's wall distances)", "C8", "-"),
 }
 
 
@@ -205,7 +206,7 @@ def make_v4_cells(args: argparse.Namespace) -> None:
     ax.axhline(110, color="grey", lw=0.8, ls=":", label="convergence (110)")
     ax.set_xlabel("generation")
     ax.set_ylabel("best-ever ft (mean of 5 schedules)")
-    ax.set_title("S1-original: version 4's options one at a time, versions 5-8 (seed 1)")
+    ax.set_title("S1-original: version 4's options one at a time, versions 5-9 (seed 1)")
     ax.legend(loc="lower right", fontsize=8)
     fig.tight_layout()
     fig.savefig(DOCS / "evidence" / "original-S1-v4" / "cells.png", dpi=110)
