@@ -10,7 +10,7 @@ how many seeds it scored higher, equal and lower, and the two-sided Wilcoxon sig
 (scipy's ``wilcoxon``; zero differences dropped).
 
 ``--protocol original`` runs them in the original protocol's world (``evolution.run.protocol``:
-zone 20 x 4, the pickup box at the robot's centre, the Khepera-like IR curve), where a champion of
+zone 20 x 4, the pickup box at the robot's centre, the original's sensor readings), where a champion of
 an ``S1-original`` run was evolved; the default is the paper's world. ``--world-from
 CHAMPION.json`` runs them in the world a champion was evolved in (its ``environment`` keys, such
 as ``drive_model`` or ``schedule``, but not a one-layout run's ``layout_seed``: the episodes' seeds
@@ -206,7 +206,7 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0, help="first episode seed")
     parser.add_argument("--protocol", choices=PROTOCOLS, default=None,
                         help="whose world: paper (default) or original (zone 20 x 4, centre pickup box, "
-                             "Khepera-like IR; evolution.run.protocol)")
+                             "the original's sensor readings; evolution.run.protocol)")
     parser.add_argument("--world-from", type=Path, metavar="CHAMPION",
                         help="the world a champion.json was evolved in (its environment keys; its preset, "
                              "steps and team size unless given); not with --protocol")
