@@ -889,105 +889,40 @@ def test_the_bearings_note_and_the_bearings_run_are_version_5():
     assert mine["substrate"] == theirs["substrate"] | {"bearings": "atan"}
 
 
-def test_the_colour_note_and_the_version_6_run():
-    """Version 6's runs say at their start that their colour reading rises with distance; the
-    committed version-6 run is the S1-original preset at version 6 key for key and differs from
-    the version-5 run by the colour reading alone."""
+@pytest.mark.parametrize("version, folder, before, added, note", [
+    (6, "original-S1-v6", "original-S1-v4-atan-bearings", {"colour_response": "farther"}, "colour_response = farther"),
+    (7, "original-S1-v7", "original-S1-v6", {"block_sighting": "rays"}, "block_sighting = rays"),
+    (8, "original-S1-v8", "original-S1-v7", {"ir_response": "khepera", "bottom_response": "khepera"},
+     "ir_response = khepera, bottom_response = khepera"),
+    (9, "original-S1-v9", "original-S1-v8", {"wall_distance": "original"}, "wall_distance = original"),
+])
+def test_each_sensing_version_says_so_and_its_run_is_the_preset(version, folder, before, added, note):
+    """A run under version 6-9 says at its start what the version reads as the original did (with
+    either method); the version before does not; the committed run of the version is the
+    S1-original preset at that version key for key, and differs from the run of the version
+    before by the version's world keys alone."""
     from dataclasses import replace
 
     from evolution.run.trainer import protocol_notes
 
     path, overrides = resolve_preset("S1-original")
-    exp = load_experiment(path, {**(overrides or {}), "protocol_version": 6})
-    assert exp.world_config().colour_response == "farther"
-    assert any("colour_response = farther" in n for n in protocol_notes(exp))
-    assert any("colour_response = farther" in n for n in protocol_notes(replace(exp, method="neat-m")))
-    v5 = load_experiment(path, {**(overrides or {}), "protocol_version": 5})
-    assert not any("colour_response" in n for n in protocol_notes(v5))
+    exp = load_experiment(path, {**(overrides or {}), "protocol_version": version})
+    assert {k: exp.environment[k] for k in added} == added
+    assert sum(note in n for n in protocol_notes(exp)) == 1
+    assert any(note in n for n in protocol_notes(replace(exp, method="neat-m")))
+    previous = load_experiment(path, {**(overrides or {}), "protocol_version": version - 1})
+    assert not any(note in n for n in protocol_notes(previous))
     drop = ("name", "source", "protocol", "protocol_version")
-    record = load_experiment(EVIDENCE / "original-S1-v6" / "experiment.toml")
-    mine = {k: v for k, v in record.to_dict().items() if k not in drop}
+    mine = {k: v for k, v in load_experiment(EVIDENCE / folder / "experiment.toml").to_dict().items() if k not in drop}
     assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
-    before = load_experiment(EVIDENCE / "original-S1-v4-atan-bearings" / "experiment.toml")
-    theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
+    theirs = {k: v for k, v in load_experiment(EVIDENCE / before / "experiment.toml").to_dict().items() if k not in drop}
     assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
-    assert mine["environment"] == theirs["environment"] | {"colour_response": "farther"}
+    assert mine["environment"] == theirs["environment"] | added
 
 
-def test_the_sighting_note_and_the_version_7_run():
-    """Version 7's runs say at their start that blocks are seen along three rays; the committed
-    version-7 run is the S1-original preset at version 7 key for key and differs from the
-    version-6 run by the block sighting alone."""
-    from dataclasses import replace
-
-    from evolution.run.trainer import protocol_notes
-
+def test_the_newest_bundle_is_version_9():
     path, overrides = resolve_preset("S1-original")
-    exp = load_experiment(path, {**(overrides or {}), "protocol_version": 7})
-    assert exp.world_config().block_sighting == "rays"
-    assert any("block_sighting = rays" in n for n in protocol_notes(exp))
-    assert any("block_sighting = rays" in n for n in protocol_notes(replace(exp, method="neat-m")))
-    v6 = load_experiment(path, {**(overrides or {}), "protocol_version": 6})
-    assert not any("block_sighting" in n for n in protocol_notes(v6))
-    drop = ("name", "source", "protocol", "protocol_version")
-    record = load_experiment(EVIDENCE / "original-S1-v7" / "experiment.toml")
-    mine = {k: v for k, v in record.to_dict().items() if k not in drop}
-    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
-    before = load_experiment(EVIDENCE / "original-S1-v6" / "experiment.toml")
-    theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
-    assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
-    assert mine["environment"] == theirs["environment"] | {"block_sighting": "rays"}
-
-
-def test_the_khepera_note_and_the_version_8_run():
-    """Version 8's runs say at their start that the infrared and bottom sensors read the
-    original's Khepera curve; the committed version-8 run is the S1-original preset at version 8
-    key for key and differs from the version-7 run by the two curves alone."""
-    from dataclasses import replace
-
-    from evolution.run.trainer import protocol_notes
-
-    path, overrides = resolve_preset("S1-original")
-    exp = load_experiment(path, {**(overrides or {}), "protocol_version": 8})
-    assert (exp.world_config().ir_response, exp.world_config().bottom_response) == ("khepera", "khepera")
-    note = [n for n in protocol_notes(exp) if "Khepera curve" in n]
-    assert len(note) == 1 and "ir_response = khepera, bottom_response = khepera" in note[0]
-    assert any("Khepera curve" in n for n in protocol_notes(replace(exp, method="neat-m")))
-    v7 = load_experiment(path, {**(overrides or {}), "protocol_version": 7})
-    assert not any("Khepera curve" in n for n in protocol_notes(v7))
-    drop = ("name", "source", "protocol", "protocol_version")
-    record = load_experiment(EVIDENCE / "original-S1-v8" / "experiment.toml")
-    mine = {k: v for k, v in record.to_dict().items() if k not in drop}
-    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
-    before = load_experiment(EVIDENCE / "original-S1-v7" / "experiment.toml")
-    theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
-    assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
-    assert mine["environment"] == theirs["environment"] | {"ir_response": "khepera", "bottom_response": "khepera"}
-
-
-def test_the_wall_note_and_the_version_9_run():
-    """The newest bundle's runs say at their start that walls are read at the original's
-    distances; the committed version-9 run is the S1-original preset key for key and differs
-    from the version-8 run by the wall distances alone."""
-    from dataclasses import replace
-
-    from evolution.run.trainer import protocol_notes
-
-    path, overrides = resolve_preset("S1-original")
-    exp = load_experiment(path, overrides)
-    assert exp.world_config().wall_distance == "original"
-    assert any("wall_distance = original" in n for n in protocol_notes(exp))
-    assert any("wall_distance = original" in n for n in protocol_notes(replace(exp, method="neat-m")))
-    v8 = load_experiment(path, {**(overrides or {}), "protocol_version": 8})
-    assert not any("wall_distance" in n for n in protocol_notes(v8))
-    drop = ("name", "source", "protocol", "protocol_version")
-    record = load_experiment(EVIDENCE / "original-S1-v9" / "experiment.toml")
-    mine = {k: v for k, v in record.to_dict().items() if k not in drop}
-    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
-    before = load_experiment(EVIDENCE / "original-S1-v8" / "experiment.toml")
-    theirs = {k: v for k, v in before.to_dict().items() if k not in drop}
-    assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
-    assert mine["environment"] == theirs["environment"] | {"wall_distance": "original"}
+    assert load_experiment(path, overrides).protocol_version == 9
 
 
 def test_a_one_layout_run_refuses_a_layout_seed_of_its_own(tmp_path):
