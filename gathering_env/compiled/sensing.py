@@ -54,30 +54,30 @@ from .tables import (
 
 
 @njit(cache=True)
-def _wall_distance(mx, my, hx, hy, cos_half, sin_half, width, height):
-    """Distance from a mount to the nearest wall point inside its cone (inf if none).
+def _wall_gap(wall, mx, my, hx, hy, cos_half, sin_half, width, height):
+    """Distance from a mount to the nearest point of one wall inside its cone (inf if none).
 
-    Walls in the order west, east, south, north, with outward normals (-1, 0), (1, 0),
-    (0, -1), (0, 1) and tangents (0, -1), (0, 1), (-1, 0), (1, 0)."""
+    Walls 0-3 are west, east, south, north, with outward normals (-1, 0), (1, 0), (0, -1),
+    (0, 1) and tangents (0, -1), (0, 1), (-1, 0), (1, 0)."""
+    if wall == 0:
+        cos_d, sin_d, perp = -hx, abs(hy), mx
+    elif wall == 1:
+        cos_d, sin_d, perp = hx, abs(hy), width - mx
+    elif wall == 2:
+        cos_d, sin_d, perp = -hy, abs(hx), my
+    else:
+        cos_d, sin_d, perp = hy, abs(hx), height - my
+    perp = max(perp, 0.0)   # a mount outside the arena (robot overlapping a wall) touches it
+    cos_eff = 1.0 if cos_d >= cos_half else cos_d * cos_half + sin_d * sin_half
+    return perp / cos_eff if cos_eff > 1e-9 else np.inf
+
+
+@njit(cache=True)
+def _wall_distance(mx, my, hx, hy, cos_half, sin_half, width, height):
+    """Distance from a mount to the nearest wall point inside its cone (inf if none)."""
     best = np.inf
     for wall in range(4):
-        if wall == 0:
-            cos_d, sin_d, perp = -hx, abs(-hy), mx
-        elif wall == 1:
-            cos_d, sin_d, perp = hx, abs(hy), width - mx
-        elif wall == 2:
-            cos_d, sin_d, perp = -hy, abs(-hx), my
-        else:
-            cos_d, sin_d, perp = hy, abs(hx), height - my
-        perp = max(perp, 0.0)   # a mount outside the arena (robot overlapping a wall) touches it
-        if cos_d >= cos_half:
-            cos_eff = 1.0
-        else:
-            cos_eff = cos_d * cos_half + sin_d * sin_half
-        if cos_eff > 1e-9:
-            dist = perp / cos_eff
-            if dist < best:
-                best = dist
+        best = min(best, _wall_gap(wall, mx, my, hx, hy, cos_half, sin_half, width, height))
     return best
 
 
@@ -88,22 +88,14 @@ def _original_wall_distance(mx, my, hx, hy, cos_half, sin_half, width, height, r
     best = np.inf
     g = sin_half / cos_half
     for wall in range(4):
-        if wall == 0:
-            cos_d, sin_d, perp = -hx, abs(-hy), mx
-            ax_w, ay_w, bx_w, by_w = 0.0, 0.0, 0.0, height
-        elif wall == 1:
-            cos_d, sin_d, perp = hx, abs(hy), width - mx
-            ax_w, ay_w, bx_w, by_w = width, 0.0, width, height
-        elif wall == 2:
-            cos_d, sin_d, perp = -hy, abs(-hx), my
-            ax_w, ay_w, bx_w, by_w = 0.0, 0.0, width, 0.0
-        else:
-            cos_d, sin_d, perp = hy, abs(hx), height - my
-            ax_w, ay_w, bx_w, by_w = 0.0, height, width, height
-        perp = max(perp, 0.0)
-        cos_eff = 1.0 if cos_d >= cos_half else cos_d * cos_half + sin_d * sin_half
-        if cos_eff <= 1e-9 or perp / cos_eff >= rng:
+        if _wall_gap(wall, mx, my, hx, hy, cos_half, sin_half, width, height) >= rng:
             continue
+        # the wall's ends A, B as the original orders them: west (0, 0)-(0, H), east (W, 0)-(W, H),
+        # south (0, 0)-(W, 0), north (0, H)-(W, H)
+        ax_w = width if wall == 1 else 0.0
+        ay_w = height if wall == 3 else 0.0
+        bx_w = 0.0 if wall == 0 else width
+        by_w = 0.0 if wall == 2 else height
         ax = (ax_w - mx) * hx + (ay_w - my) * hy
         ay = (ay_w - my) * hx - (ax_w - mx) * hy
         bx = (bx_w - mx) * hx + (by_w - my) * hy

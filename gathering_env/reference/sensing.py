@@ -257,12 +257,12 @@ class SensorBank:
             seen = dist < self._range_c[None, :, None]
             cfg = self.config
             buggy = original_wall_distance(mx[..., None], my[..., None], hx[..., None], hy[..., None],
-                                           self._cos_half_w, self._sin_half_w, _WALL_ENDS(cfg.arena_width, cfg.arena_height))
+                                           self._cos_half_w, self._sin_half_w, _wall_ends(cfg.arena_width, cfg.arena_height))
             return np.where(seen, buggy, np.inf).min(axis=-1)
         return dist.min(axis=-1)
 
 
-def _WALL_ENDS(width, height):
+def _wall_ends(width, height):
     """(4, 2, 2) end points of the walls west, east, south, north (their order in the kernels)."""
     return np.array([[[0.0, 0.0], [0.0, height]], [[width, 0.0], [width, height]],
                      [[0.0, 0.0], [width, 0.0]], [[0.0, height], [width, height]]])
