@@ -1,4 +1,4 @@
-"""Compare team policies on the same seeds: random, a fixed search pattern, evolved champions, PPO.
+"""Compare team policies on the same seeds: random, a fixed search pattern, a privileged oracle, evolved champions, PPO.
 
 ``gathering-compare --policy random --policy heuristic --policy wander --policy champion:run/champion.json
 --policy ppo:ppo/model.zip --environment 2 --episodes 5 --out compare/`` runs every policy on
@@ -43,6 +43,8 @@ from gathering_env import WorldConfig, parallel_env
 def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
     obs_dict, _ = env.reset(seed=seed, options={"morphology": policy.morphology})
     policy.reset(seed)
+    if policy.bind is not None:
+        policy.bind(env.sim)
     obs = np.stack([obs_dict[a] for a in env.possible_agents])
     if obs.shape[1] != len(policy.morphology):
         raise ValueError(f"policy {policy.name}: observation width {obs.shape[1]} != {len(policy.morphology)}")

@@ -74,6 +74,8 @@ def replay(team: Champion | Policy, env_config: dict[str, Any], seed: int, out: 
     video = VideoWriter(out, fps=fps)  # checks the suffix and fps before the episode
     obs_dict, _ = env.reset(seed=seed, options={"morphology": team.morphology})
     team.reset(seed)
+    if team.bind is not None:
+        team.bind(env.sim)
     obs = np.stack([obs_dict[a] for a in env.possible_agents])
     panels: dict[int, np.ndarray] = {}
     captions: dict[int, str] = {}

@@ -10,6 +10,9 @@ from a name, as ``gathering-compare --policy`` takes it. Policies (each carries 
 * ``wander``: the speed benchmark's explorer (``evolution.policies.scripted.WanderTeam``): forward
   at 0.8 of top speed with a drift redrawn every 50 steps, spin on the spot when the front
   ultrasonic has read an obstacle very close for 20 steps (Khepera III morphology).
+* ``oracle``: a privileged scripted team (``evolution.policies.oracle``) that reads the world's
+  state, not its sensors, and pushes every block to the zone with the robots it needs: an upper
+  reference for what a world allows, not a controller a robot could run.
 * ``champion:PATH``: an evolved team from a champion JSON (its own morphology).
 * ``ppo:PATH``: a Stable-Baselines3 PPO model (``examples/rl_ppo.py``) with the morphology
   saved next to it (``PATH`` with suffix ``.morphology.json``), Khepera III if absent; its
@@ -22,15 +25,15 @@ from a name, as ``gathering-compare --policy`` takes it. Policies (each carries 
   action. ``benchmarl-sample:PATH``: actions sampled as in training.
 
 Modules: ``scripted`` (random, heuristic, ``WanderTeam``), ``evolved`` (champion files),
-``learned`` (Stable-Baselines3 models), ``marl`` (BenchMARL / TorchRL policy files).
+``oracle`` (the privileged team), ``learned`` (Stable-Baselines3 models), ``marl`` (BenchMARL / TorchRL policy files).
 """
 
 from __future__ import annotations
 
-from evolution.policies import evolved, learned, marl, scripted
+from evolution.policies import evolved, learned, marl, oracle, scripted
 from evolution.policies.base import Policy
 
-KINDS = ("random", "heuristic", "wander", "champion", "ppo", "ppo-sample", "benchmarl", "benchmarl-sample")
+KINDS = ("random", "heuristic", "wander", "oracle", "champion", "ppo", "ppo-sample", "benchmarl", "benchmarl-sample")
 """The kinds of policy name: ``KIND`` or ``KIND:PATH``."""
 
 
@@ -48,6 +51,8 @@ def make_policy(spec: str) -> Policy:
         return scripted.heuristic_policy()
     if kind == "wander" and not arg:
         return scripted.wander_policy()
+    if kind == "oracle" and not arg:
+        return oracle.oracle_policy()
     if kind == "champion" and arg:
         return evolved.champion_policy(arg)
     if kind in ("ppo", "ppo-sample") and arg:
@@ -57,9 +62,9 @@ def make_policy(spec: str) -> Policy:
     raise ValueError(f"--policy {spec}: unknown policy; allowed: {POLICY_NAMES}")
 
 
-POLICY_NAMES = ("random, heuristic, wander, champion:PATH, ppo:PATH, ppo-sample:PATH, benchmarl:PATH, "
+POLICY_NAMES = ("random, heuristic, wander, oracle, champion:PATH, ppo:PATH, ppo-sample:PATH, benchmarl:PATH, "
                 "benchmarl-sample:PATH")
 """The names ``make_policy`` takes (for help texts and errors)."""
 
 
-__all__ = ["KINDS", "POLICY_NAMES", "Policy", "is_policy_name", "make_policy", "evolved", "learned", "marl", "scripted"]
+__all__ = ["KINDS", "POLICY_NAMES", "Policy", "is_policy_name", "make_policy", "evolved", "learned", "marl", "oracle", "scripted"]

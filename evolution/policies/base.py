@@ -15,6 +15,9 @@ class Policy:
 
     ``environment``: world parameters it was evolved or trained in (``WorldConfig`` keywords,
     e.g. ``{"environment": 1, "max_cycles": 2000}``), the defaults of ``gathering-replay``; None if unknown.
+    ``bind``: for a privileged policy that reads the world's state (``oracle``), called with the
+    episode's ``GatheringSimulation`` after each reset (``evolution.compare.run_episode`` and
+    ``evolution.replay`` do); None for policies that read only their observations.
     """
 
     name: str
@@ -22,6 +25,7 @@ class Policy:
     act: Any
     reset: Any = field(default=lambda seed: None)
     environment: dict[str, Any] | None = None
+    bind: Any = None
 
 
 __all__ = ["Policy"]
