@@ -27,8 +27,9 @@ speciation, by ``species_mode`` in its config section ``[GatheringSpeciesSet]``:
   every genome but the leaders founds a species; ``threshold_min`` is the adaptive rule's). The
   count that moves it is of the species that *survived*: with the ratchet and elite rate 0 (the
   2018 SO set-up) only the best genome's species does, so the threshold falls by 0.01 every
-  generation, below 0 from generation 100, and from then on every genome is its own species,
-  as in the original. In single-objective runs
+  generation, below 0 from generation 100, and from then on every genome is its own species.
+  (In the original a second, leaderless species can survive and hold the threshold still:
+  Encog's species-pointer bookkeeping, not modelled; docs/fidelity.md says when.) In single-objective runs
   species are also Encog's (``leaders``, set by ``use_original_rule``): generation 0 is one
   species; a species is represented by its *leader* (its best genome, which
   ``NEATReproduction`` names after each evaluation; on a tie the leader keeps its place) and
