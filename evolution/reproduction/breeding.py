@@ -52,6 +52,7 @@ import neat
 from neat.config import ConfigParameter, DefaultClassConfig
 from neat.math_util import mean
 
+from evolution.reproduction.bookkeeping import inherit_pointer, levelled_order
 from evolution.reproduction.encog import (
     ENCOG_WEIGHT_OPERATIONS,
     ORIGINAL_ELITE_MIN_MEMBERS,
@@ -310,7 +311,9 @@ class NEATReproduction(neat.DefaultReproduction):
         config.genome_config.innovation_tracker = self.innovation_tracker
         self.innovation_tracker.reset_generation()
         ratchet = getattr(self.reproduction_config, "ratchet", False)
-        if ratchet:
+        if getattr(species, "deferred", False):
+            self._speciate_scored(config, species, generation)
+        elif ratchet:
             for s in species.species.values():
                 for k in sorted(s.members):
                     g = s.members[k]
@@ -319,7 +322,10 @@ class NEATReproduction(neat.DefaultReproduction):
         self.carried = set()
         remaining, fitnesses = [], []
         spared = self._best_species(species, ratchet)
-        for sid, s, stagnant in self.stagnation.update(species, generation):
+        updated = self.stagnation.update(species, generation)
+        if getattr(species, "deferred", False) and all(stagnant and sid != spared for sid, _, stagnant in updated):
+            spared = list(species.species)[-1]  # Encog never removes the last species
+        for sid, s, stagnant in updated:
             stagnant = stagnant and sid != spared
             if stagnant:
                 self.reporters.species_stagnant(sid, s)
@@ -365,12 +371,33 @@ class NEATReproduction(neat.DefaultReproduction):
                                         self.ancestors))
         return new_population
 
+    def _speciate_scored(self, config: Any, species: Any, generation: int) -> None:
+        """Encog's books (``evolution.reproduction.bookkeeping``): the ratchet's best genome (before
+        the first breeding the first valid genome, whatever it scored; then a genome replaces it
+        only by beating it), then the speciation of the scored population."""
+        from evolution.reproduction.bookkeeping import first_best
+
+        population = species.pending
+        if self.best is None:
+            self.best = first_best(population)
+        else:
+            for k in sorted(population):
+                if population[k].fitness > self.best.fitness:
+                    self.best = population[k]
+        species.speciate_scored(config, generation, self.best)
+
     def _best_species(self, species: Any, ratchet: bool) -> int | None:
         """With Encog's selection, the species that stagnation never removes: the one holding the
-        best genome (``_best_key``); None with neat-python's selection (its ``species_elitism``
-        spares the fittest species)."""
+        best genome (``_best_key``), with Encog's books the one the best genome points at (None if
+        it points at none); None with neat-python's selection (its ``species_elitism`` spares the
+        fittest species)."""
         if not getattr(species.species_set_config, "leaders", False):
             return None
+        if getattr(species, "deferred", False):
+            from evolution.reproduction.bookkeeping import pointer
+
+            sid = pointer(self.best)
+            return sid if sid in species.species else None
         holder = {k: sid for sid, s in species.species.items() for k in s.members}
         fitness = {k: g.fitness for s in species.species.values() for k, g in s.members.items()}
         return holder.get(self._best_key(fitness, ratchet)) if fitness else None
@@ -392,8 +419,14 @@ class NEATReproduction(neat.DefaultReproduction):
         """Encog's selection (see the class docstring) over the non-stagnant species."""
         ranked = {s.key: sorted(s.members, key=lambda k: (s.members[k].fitness, k), reverse=True) for s in remaining}
         fitness = {k: g.fitness for s in remaining for k, g in s.members.items()}
-        best_key = self._best_key(fitness, ratchet)
-        best_index = next((i for i, s in enumerate(remaining) if best_key in s.members), 0)
+        books = getattr(species, "deferred", False)  # Encog's books: evolution.reproduction.bookkeeping
+        if books:
+            spared = self._best_species(species, ratchet)
+            best_index = next((i for i, s in enumerate(remaining) if s.key == spared), None)
+        else:
+            best_key = self._best_key(fitness, ratchet)
+            best_index = next((i for i, s in enumerate(remaining) if best_key in s.members), 0)
+        order_before = list(species.species)
         counts = original_spawn([mean([m.fitness for m in s.members.values()]) for s in remaining],
                                 [s.members[ranked[s.key][0]].fitness for s in remaining], best_index, offspring)
         new_population = self._start_population(ratchet)
@@ -404,7 +437,8 @@ class NEATReproduction(neat.DefaultReproduction):
             members = dict(s.members)
             order = ranked[s.key]
             s.members = {}
-            s.representative = members[original_leader(members, s.representative.key)]  # of the next speciation
+            if not books:  # Encog's books chose the leader during the speciation
+                s.representative = members[original_leader(members, s.representative.key)]  # of the next speciation
             species.species[s.key] = s
             if len(order) > ORIGINAL_ELITE_MIN_MEMBERS:
                 for k in order[:min(n, int(len(order) * config.reproduction_config.original_elite_rate))]:
@@ -415,6 +449,12 @@ class NEATReproduction(neat.DefaultReproduction):
                     if ratchet:
                         self.carried.add(k)
             score = {k: float(members[k].fitness) for k in order}
-            new_population.update(breed(order, members, score, n, config, lambda: next(self.genome_indexer),
-                                        self.ancestors))
+            children = breed(order, members, score, n, config, lambda: next(self.genome_indexer), self.ancestors)
+            if books:
+                for k, child in children.items():
+                    inherit_pointer(child, tuple(members[p] for p in self.ancestors[k]))
+            new_population.update(children)
+        if books:  # Encog's levelOff sorts the species for the next speciation
+            species.species = levelled_order({sid: species.species[sid] for sid in order_before
+                                              if sid in species.species})
         return new_population

@@ -84,11 +84,12 @@ def java_round(x: float) -> int:
     return int(math.floor(x + 0.5))
 
 
-def original_spawn(means: list[float], bests: list[float], best: int, places: int) -> list[int]:
+def original_spawn(means: list[float], bests: list[float], best: int | None, places: int) -> list[int]:
     """Encog's offspring counts per species (``ThresholdSpeciation``), 0 for a species that dies.
 
     ``means``: each species' mean score (its share; negative counts as 0), ``bests``: its best
-    score, ``best``: index of the species holding the best genome, ``places``: offspring to
+    score, ``best``: index of the best species (the one holding the best genome; with Encog's
+    books the one it points at, None if that is not among them), ``places``: offspring to
     place. Each species gets ``round(share / total * places)``; a species whose count rounds to 0
     dies (not the best one, which gets at least 1); with every share 0 each gets
     ``round(places / n)``. Then *level off*: species ordered by best score, the first gets at
@@ -102,7 +103,8 @@ def original_spawn(means: list[float], bests: list[float], best: int, places: in
         counts = [java_round(places / n)] * n
     else:
         counts = [java_round(share / total * places) for share in shares]
-        counts[best] = max(counts[best], 1)
+        if best is not None:
+            counts[best] = max(counts[best], 1)
     order = sorted((i for i in range(n) if counts[i] > 0), key=lambda i: (-bests[i], i))
     counts[order[0]] = max(counts[order[0]], 1)
     diff = places - sum(counts)

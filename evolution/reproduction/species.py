@@ -29,15 +29,17 @@ speciation, by ``species_mode`` in its config section ``[GatheringSpeciesSet]``:
   2018 SO set-up) only the best genome's species does, so the threshold falls by 0.01 every
   generation, below 0 from generation 100, and from then on every genome is its own species.
   (In the original a second, leaderless species can survive and hold the threshold still:
-  Encog's species-pointer bookkeeping, not modelled; docs/fidelity.md says when.) In single-objective runs
+  Encog's species-pointer bookkeeping, ``species_bookkeeping = "encog"``, with which a population
+  is speciated after scoring: ``evolution.reproduction.bookkeeping``.) In single-objective runs
   species are also Encog's (``leaders``, set by ``use_original_rule``): generation 0 is one
   species; a species is represented by its *leader* (its best genome, which
   ``NEATReproduction`` names after each evaluation; on a tie the leader keeps its place) and
   is disbanded when its leader is not in the new population; a genome joins the first
   species, oldest first, whose leader is within the threshold (``<=``), else it founds a new
-  one. If every species was disbanded (Encog stops there with an error), the population is one
-  species again, as in generation 0. (neat-python instead keeps every species that finds a
-  closest genome and puts a genome in the nearest species.)
+  one. If every species was disbanded, the population is one species again, as in generation
+  0 (Encog keeps its last species instead; under the ratchet neither happens, as the best genome
+  leads its species). (neat-python instead keeps every species that finds a closest genome and
+  puts a genome in the nearest species.)
 * ``fixed``: neat-python's behaviour (the threshold never moves).
 
 The threshold and the species count of every generation are in ``history`` (and the run's
@@ -151,6 +153,7 @@ class SpeciesSetConfig(DefaultClassConfig):
             ConfigParameter("min_species", int, 2),
         ])
         self.leaders = False  # Encog's species of leaders (SO, original mode): set by use_original_rule
+        self.bookkeeping = "membership"  # or "encog" (evolution.reproduction.bookkeeping): set by neat_setup
         problems = []
         if self.species_mode not in MODES:
             problems.append(("species_mode", self.species_mode, " / ".join(MODES)))
@@ -178,13 +181,25 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
         super().__init__(config, reporters)
         self.threshold = float(config.compatibility_threshold)
         self.history: list[tuple[int, float, int]] = []  # (generation, threshold used, species)
+        self.pending: dict[int, Any] | None = None  # Encog's books: the population to speciate once scored
 
     @classmethod
     def parse_config(cls, param_dict: dict[str, Any]) -> SpeciesSetConfig:
         return SpeciesSetConfig(param_dict)
 
+    @property
+    def deferred(self) -> bool:
+        """Encog's books (``evolution.reproduction.bookkeeping``): a population is speciated
+        after it has been scored (``speciate_scored``), not when it is made."""
+        cfg = self.species_set_config
+        return cfg.species_mode == "original" and getattr(cfg, "leaders", False) and \
+            getattr(cfg, "bookkeeping", "membership") == "encog"
+
     def speciate(self, config: Any, population: dict[int, Any], generation: int) -> None:
         cfg = self.species_set_config
+        if self.deferred:  # kept until it is scored: NEATReproduction calls speciate_scored
+            self.pending = population
+            return
         leaders = cfg.species_mode == "original" and getattr(cfg, "leaders", False)
         if leaders:
             # Encog's resetSpecies: a species whose leader did not survive is disbanded
@@ -209,6 +224,15 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
             target = target_count(cfg.target_species, getattr(config, "pop_size", None) or len(population))
             self.threshold = adapted_threshold(used, count, target, cfg.threshold_step,
                                                cfg.threshold_min, new_species=bool(set(self.species) - before))
+
+    def speciate_scored(self, config: Any, generation: int, best: Any) -> None:
+        """Encog's speciation of the population kept by ``speciate``, now scored, with the
+        ratchet's ``best`` genome (``evolution.reproduction.bookkeeping.speciate_scored``)."""
+        from evolution.reproduction.bookkeeping import speciate_scored
+
+        population, self.pending = self.pending, None
+        used, count = speciate_scored(self, config, population, generation, best)
+        self.history.append((int(generation), used, count))
 
     def speciate_pool(self, config: Any, population: dict[int, Any], generation: int) -> None:
         """Speciate at the current threshold without a step or a record: NEAT-MODS speciates
@@ -299,6 +323,7 @@ class GatheringSpeciesSet(neat.DefaultSpeciesSet):
         super().__setstate__(state)
         self.__dict__.setdefault("threshold", float(self.species_set_config.compatibility_threshold))
         self.__dict__.setdefault("history", [])
+        self.__dict__.setdefault("pending", None)
 
 
 __all__ = ["GatheringSpeciesSet", "MODES", "ORIGINAL_COEFFICIENTS", "ORIGINAL_RULE", "use_original_rule", "SECTION", "SpeciesSetConfig",

@@ -28,6 +28,9 @@ Layout (every key optional except where noted; defaults are the paper's, docs/mo
                                  # at least two) or "encog" (floor, at least one: the original code)
     weights = "neat"             # link weights: "neat" (the neat config's weight_/bias_ keys) or
                                  # "encog" (the original's: uniform in +-5, its weight operations)
+    species_bookkeeping = "membership"   # SO with speciation = "original" and the ratchet:
+                                 # "encog" keeps Encog's species pointers, zombie species and
+                                 # generation 0 (evolution.reproduction.bookkeeping)
 
     [environment]                # any gathering_env keyword: environment, max_cycles, ...
     environment = 2
@@ -55,6 +58,7 @@ from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
+from evolution.reproduction.bookkeeping import BOOKKEEPING
 from evolution.reproduction.breeding import TRUNCATIONS
 from evolution.reproduction.encog import WEIGHT_SCHEMES
 from evolution.run.presets import CONFIG_DIR, DEFAULT_NEAT_CONFIGS
@@ -86,7 +90,8 @@ def _species_modes() -> tuple[str, ...]:
 #: Keys whose value is one of a few names.
 CHOICES = {"method": lambda: METHODS, "speciation": _species_modes, "protocol": lambda: PROTOCOLS,
            "layout": lambda: LAYOUTS, "elitism": lambda: ELITISM, "complexity": lambda: COMPLEXITY_FORMULAS,
-           "truncation": lambda: TRUNCATIONS, "weights": lambda: WEIGHT_SCHEMES}
+           "truncation": lambda: TRUNCATIONS, "weights": lambda: WEIGHT_SCHEMES,
+           "species_bookkeeping": lambda: BOOKKEEPING}
 
 
 class ExperimentError(ValueError):
@@ -113,6 +118,7 @@ class Experiment:
     complexity: str = "paper"
     truncation: str = "neat"  # evolution.reproduction.breeding.truncate
     weights: str = "neat"  # "encog": evolution.reproduction.encog.use_encog_weights
+    species_bookkeeping: str = "membership"  # "encog": evolution.reproduction.bookkeeping
     neat_config: Path = field(default_factory=lambda: CONFIG_DIR / DEFAULT_NEAT_CONFIGS["hyperneat-m"])
     environment: dict[str, Any] = field(default_factory=lambda: {"environment": 2, "max_cycles": 10_000})
     substrate: dict[str, Any] = field(default_factory=dict)
@@ -212,7 +218,7 @@ def experiment_from_run(saved: dict[str, Any], source: str, overrides: dict[str,
 
 #: ``[experiment]`` keys added after runs were first recorded: a saved experiment without one
 #: was run with its default (``with_protocol_version`` fills it in).
-LATER_KEYS = ("truncation", "weights")
+LATER_KEYS = ("truncation", "weights", "species_bookkeeping")
 
 
 def with_protocol_version(saved: dict[str, Any]) -> dict[str, Any]:
@@ -308,7 +314,13 @@ def _validate(raw: dict[str, Any], source: str, base: Path, overrides: dict[str,
                               f"[substrate] section for method {method!r}")
     values["environment"] = env_section
     values["substrate"] = sub_section
-    return Experiment(**values)
+    experiment = Experiment(**values)
+    if experiment.species_bookkeeping == "encog" and not experiment.multi_objective and (
+            experiment.speciation != "original" or experiment.elitism != "ratchet"):
+        raise ExperimentError(f"{source}: [experiment] species_bookkeeping = 'encog' keeps Encog's books of its "
+                              "species of leaders; allowed: with speciation = 'original' and elitism = 'ratchet' "
+                              "(or species_bookkeeping = 'membership')")
+    return experiment
 
 
 def _check_key(source: str, key: str, value: Any) -> Any:

@@ -67,6 +67,7 @@ def make_neat_config(experiment: Experiment) -> neat.Config:
         species.species_mode = experiment.speciation
         if experiment.speciation == "original":
             use_original_rule(species, experiment.multi_objective, experiment.population)
+            species.bookkeeping = experiment.species_bookkeeping  # SO: evolution.reproduction.bookkeeping
             if not experiment.multi_objective:  # Encog's stagnation (NEATReproduction's Encog selection)
                 from evolution.reproduction.encog import ORIGINAL_MAX_STAGNATION, ORIGINAL_SPECIES_ELITISM
 

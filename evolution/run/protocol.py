@@ -28,6 +28,10 @@ key                           paper (default)     original
                                                   shares, no species elites (the 2018 code's
                                                   rate 0) and stagnation 15
                                                   (``evolution.reproduction.breeding``)
+``[experiment]                ``"membership"``    ``"encog"`` (version 10, SO): Encog's species
+species_bookkeeping``                             pointers, zombie species, speciation after
+                                                  scoring, its generation 0
+                                                  (``evolution.reproduction.bookkeeping``)
 ``[environment] zone_depth``  8                   4 (zone 20 x 4)
 ``[environment] pickup_box``  ``"front"``         ``"centre"``, 0.1 forward x 0.2 across
 ``[environment] ir_response`` ``"linear"``        ``"gamma"`` (a steeper curve; versions 1-7),
@@ -99,10 +103,16 @@ newest one whose keys it holds with the same values (``saved_version``). The ori
    they took for it) and for the bottom sensor (``bottom_response = "khepera"``: a disc ahead of
    the centre, on over the zone and off within about 0.01 of it, where versions 1-7 read the
    centre with a 1-unit falloff).
-9. (2026-12, the newest) adds the 2018 simulator's wall distances (``wall_distance =
+9. (2026-12) adds the 2018 simulator's wall distances (``wall_distance =
    "original"``): its sensors read a wall they see at the distance its line formulas give
    (``gathering_env.reference.sensing.original_wall_distance``), which mix the sensor's frame with
    the world's, where versions 1-8 read the wall's nearest point in the cone.
+10. (2026-12, the newest) adds Encog's species bookkeeping (``species_bookkeeping = "encog"``,
+    single-objective runs): the best species is the one the best genome *points at* (a pointer
+    set when a genome joins a species, inherited by mutants), which survives its leader's death;
+    a population is speciated after it is scored (leaders change during the pass); generation
+    0 is speciated at 0.99, nearly a species per genome, and the ratchet starts from its first
+    genome. Versions 1-9 named species by membership (``evolution.reproduction.bookkeeping``).
 
 ``protocol = "paper"`` names the defaults (one version). A file that names a protocol and sets
 one of its keys to another value is refused (``ExperimentError`` naming the file and key);
@@ -149,6 +159,9 @@ ORIGINAL_KHEPERA = {"ir_response": "khepera", "bottom_response": "khepera"}
 #: The 2018 simulator's wall distances (version 9; ``gathering_env.reference.sensing``).
 ORIGINAL_WALLS = {"wall_distance": "original"}
 
+#: Encog's species bookkeeping (version 10; ``evolution.reproduction.bookkeeping``).
+ORIGINAL_BOOKS = {"species_bookkeeping": "encog"}
+
 #: Protocol name -> version -> {section: {key: value}}; the "paper" values are the defaults of
 #: the dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``), filled in
 #: by ``protocol_values``.
@@ -181,6 +194,10 @@ BUNDLES: dict[str, dict[int, dict[str, dict[str, Any]]]] = {
             "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE, **ORIGINAL_COLOUR,
                             **ORIGINAL_SIGHTING, **ORIGINAL_KHEPERA, **ORIGINAL_WALLS},
             "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
+        10: {"experiment": {**_METHOD, **ORIGINAL_BREEDING, **ORIGINAL_BOOKS},
+             "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE, **ORIGINAL_COLOUR,
+                             **ORIGINAL_SIGHTING, **ORIGINAL_KHEPERA, **ORIGINAL_WALLS},
+             "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
     },
     "paper": {1: {}},
 }
@@ -199,7 +216,7 @@ DESCRIPTIONS = {
     "paper": "the paper's text (the defaults)",
     "original": "the 2018 Java code that produced the published figures: one layout per run, ratchet on the best "
                 "genome, Encog's truncation and link weights, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its "
-                "sensor bearings (all on the front half), its colour reading (rising with distance), block sighting (three rays), wall distances and Khepera curve (infrared, bottom), its eq. 2, its "
+                "sensor bearings (all on the front half), its colour reading (rising with distance), block sighting (three rays), wall distances and Khepera curve (infrared, bottom), its eq. 2, Encog's species bookkeeping, its "
                 "physics (mass friction, bouncing contacts) and its robot on its shuffled schedule",
 }
 

@@ -102,6 +102,10 @@ def protocol_notes(exp: Experiment) -> list[str]:
     if exp.environment.get("wall_distance") == "original":
         notes.append(f"{exp.name}: the original's wall distances (wall_distance = original): a wall is read at the "
                      "distance the 2018 line formulas give, not its nearest point (gathering_env.reference.sensing)")
+    if exp.species_bookkeeping == "encog" and not exp.multi_objective:
+        notes.append(f"{exp.name}: Encog's species books (species_bookkeeping = encog): the best genome's species "
+                     "pointer names the best species, which outlives its leader; speciation after scoring; generation "
+                     "0 speciated at 0.99, the ratchet starting from its first genome (evolution.reproduction.bookkeeping)")
     return notes
 
 
@@ -257,6 +261,8 @@ class Trainer:
                 rebuilt = recorded is not None and evaluator.rebuilds(generation)
                 amend = evaluator.check if rebuilt else None
                 population.run(self._fitness, 1)
+                if getattr(population.species, "deferred", False):  # speciated once scored, in the run
+                    _, threshold, species_count = population.species.history[-1]
                 self._check_run_dir(generation)
                 record = recorder.record(population, generation, species_count, time.perf_counter() - start,
                                          self._current, self._current_genomes, self._failures, threshold,
