@@ -262,3 +262,24 @@ def test_encog_never_removes_its_last_species_even_when_it_stagnates():
     species.pending = {b.key: b}
     new = reproduction.reproduce(config, species, 10, 5)
     assert len(new) == 10 and all(reproduction.ancestors[k] == (b.key,) for k in new if k != b.key)
+
+
+def test_a_runs_statistics_give_the_species_and_threshold_of_each_scored_generation(tmp_path):
+    """The record of generation g under Encog's books holds the speciation of g itself, made
+    after g was scored: generation 0 nearly a species per genome at 0.99, then one step of 0.01
+    (or none) a generation; with the membership books generation 0 is one species at 1.0."""
+    from evolution.cli import evolve_main
+    from evolution.run.stats import read_stats
+    from tests.test_protocol import experiment
+
+    for books, version in (("encog", 10), ("membership", 9)):
+        exp = experiment(tmp_path, name=books, generations=3, population=10,
+                         body=f'protocol = "original"\nprotocol_version = {version}')
+        assert evolve_main([str(exp), "--out", str(tmp_path / books), "--workers", "1", "--no-progress"]) == 0
+        rows = read_stats(tmp_path / books / "stats.jsonl")
+        if books == "encog":
+            assert rows[0]["threshold"] == pytest.approx(0.99) and rows[0]["species"] >= 9
+            steps = [round(a["threshold"] - b["threshold"], 6) for a, b in zip(rows, rows[1:])]
+            assert all(step in (0.0, 0.01) for step in steps), steps
+        else:
+            assert (rows[0]["threshold"], rows[0]["species"]) == (1.0, 1)
