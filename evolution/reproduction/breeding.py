@@ -315,10 +315,7 @@ class NEATReproduction(neat.DefaultReproduction):
             self._speciate_scored(config, species, generation)
         elif ratchet:
             for s in species.species.values():
-                for k in sorted(s.members):
-                    g = s.members[k]
-                    if self.best is None or g.fitness > self.best.fitness:
-                        self.best = g
+                self._raise_best(s.members)
         self.carried = set()
         remaining, fitnesses = [], []
         spared = self._best_species(species, ratchet)
@@ -379,12 +376,16 @@ class NEATReproduction(neat.DefaultReproduction):
 
         population = species.pending
         if self.best is None:
-            self.best = first_best(population)
+            self.best = first_best(population)  # generation 0's scores do not count
         else:
-            for k in sorted(population):
-                if population[k].fitness > self.best.fitness:
-                    self.best = population[k]
+            self._raise_best(population)
         species.speciate_scored(config, generation, self.best)
+
+    def _raise_best(self, genomes: dict[int, Any]) -> None:
+        """The ratchet: a genome (in key order) replaces the best only by beating it."""
+        for k in sorted(genomes):
+            if self.best is None or genomes[k].fitness > self.best.fitness:
+                self.best = genomes[k]
 
     def _best_species(self, species: Any, ratchet: bool) -> int | None:
         """With Encog's selection, the species that stagnation never removes: the one holding the
