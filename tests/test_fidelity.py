@@ -17,8 +17,9 @@ import pytest
 from evolution.encodings.direct import NEATMGenome, SensorGene, decode_neat_m
 from evolution.encodings.genome import CPPNGenome
 from evolution.encodings.substrate import Substrate, decode
-from evolution.reproduction.breeding import BreedingGenome, NEATReproduction, breed, truncate
+from evolution.reproduction.breeding import NEATReproduction, breed, truncate
 from evolution.reproduction.mods import MODSReproduction
+from evolution.reproduction.operators import BreedingGenome
 from evolution.reproduction.species import GatheringSpeciesSet
 from gathering_env import SENSOR_TYPES
 
@@ -327,7 +328,7 @@ def test_the_original_proportion_pick_draws_each_link_with_probability_0_02(tmp_
     """Encog's SelectProportion(0.02): each link with probability 0.02, one at random if none:
     on 400 links the count varies (binomial, mean 8, variance 7.84); the shipped rule changes
     round(0.02 * 400) = 8 every time."""
-    import evolution.reproduction.breeding as breeding
+    import evolution.reproduction.operators as operators
     from evolution.reproduction.encog import use_encog_weights
 
     path = tmp_path / "big.cfg"
@@ -338,7 +339,7 @@ def test_the_original_proportion_pick_draws_each_link_with_probability_0_02(tmp_
     genome = parents(config, 1)[1]
     links = len(genome.connections) + len(genome.nodes)
     use_encog_weights(config.genome_config, "hyperneat-m")
-    monkeypatch.setattr(breeding, "ENCOG_WEIGHT_OPERATIONS", ((0.02, 1, 1.0),))
+    monkeypatch.setattr(operators, "ENCOG_WEIGHT_OPERATIONS", ((0.02, 1, 1.0),))
     counts = [len(c) for c in weight_changes(genome, config, 600)]
     p = 0.02
     assert abs(np.mean(counts) - links * p) < 0.5 and abs(np.var(counts) - links * p * (1 - p)) < 2.0

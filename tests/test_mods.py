@@ -11,8 +11,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from evolution.reproduction.breeding import BreedingGenome
 from evolution.reproduction.mods import MODSReproduction
+from evolution.reproduction.operators import BreedingGenome
 from evolution.reproduction.pareto import non_dominated_fronts
 
 NEAT_CFG = """

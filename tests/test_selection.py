@@ -23,8 +23,9 @@ import pytest
 from neat.species import Species
 from test_mods import NEAT_CFG
 
-from evolution.reproduction.breeding import BreedingGenome, NEATReproduction
+from evolution.reproduction.breeding import NEATReproduction
 from evolution.reproduction.mods import MODSReproduction
+from evolution.reproduction.operators import BreedingGenome
 
 SO_SECTION = """
 [NEATReproduction]

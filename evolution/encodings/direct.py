@@ -1,6 +1,6 @@
 """NEAT-M (Hewland & Nitschke): a NEAT controller plus directly encoded sensor genes.
 
-``NEATMGenome`` is a ``neat.DefaultGenome`` (through ``evolution.reproduction.breeding.BreedingGenome``)
+``NEATMGenome`` is a ``neat.DefaultGenome`` (through ``evolution.reproduction.operators.BreedingGenome``)
 whose network has one input per possible sensor *slot* (``num_inputs`` = 10) and two outputs
 (left, right wheel). Alongside its node and connection genes it carries ``sensors``: slot ->
 ``SensorGene`` (type, bearing, orientation, range, fov). A slot without a sensor gene
@@ -39,7 +39,7 @@ import numpy as np
 from neat.graphs import feed_forward_layers
 
 from evolution.encodings.controller import Layer, TeamController
-from evolution.reproduction.breeding import BreedingGenome, check_probability
+from evolution.reproduction.operators import BreedingGenome, check_probability
 from gathering_env import SENSOR_TYPES, Morphology, SensorSpec
 
 SENSOR_PARAMS = (

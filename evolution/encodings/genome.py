@@ -1,6 +1,6 @@
 """The HyperNEAT-M CPPN genome on neat-python.
 
-``CPPNGenome`` is a ``neat.DefaultGenome`` (through ``evolution.reproduction.breeding.BreedingGenome``)
+``CPPNGenome`` is a ``neat.DefaultGenome`` (through ``evolution.reproduction.operators.BreedingGenome``)
 whose config section (``[CPPNGenome]``) must declare 4 inputs (x1, y1, x2, y2 of the two
 substrate nodes; neat-python gives every node its own bias, so no explicit bias input is
 needed) and 6 outputs (weight, fov, orientation, range, type, bias-weight, in that order;
@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from evolution.encodings.substrate import CPPN_OUTPUTS
-from evolution.reproduction.breeding import BreedingGenome
+from evolution.reproduction.operators import BreedingGenome
 
 CPPN_INPUTS = ("x1", "y1", "x2", "y2")
 
