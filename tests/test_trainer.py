@@ -165,3 +165,41 @@ def test_neat_m_and_multi_objective_runs(tmp_path):
     assert len(front_files) == len(records[-1]["front"]["genomes"])
     objectives = [load_champion(f).objectives for f in front_files]
     assert all({"task", "morphology", "controller"} <= set(o) for o in objectives)
+
+
+def test_stop_signals_ask_then_insist_and_put_the_handlers_back(capsys):
+    """The first signal asks (the generation finishes), a second abandons it; on leaving, each
+    signal has the handler it had before (a run inside a program must not keep its handlers)."""
+    import os
+    import signal
+
+    from evolution.run.signals import SIGNALS, StopSignals
+
+    def mine(signum, frame):
+        raise AssertionError("the program's handler ran inside the run")
+
+    before = {sig: signal.getsignal(sig) for sig in SIGNALS}
+    signal.signal(signal.SIGTERM, mine)
+    try:
+        with StopSignals(lambda: 7) as stop:
+            assert not stop.requested
+            os.kill(os.getpid(), signal.SIGTERM)
+            assert stop.requested and "finishing generation 7" in capsys.readouterr().out
+            with pytest.raises(KeyboardInterrupt):
+                os.kill(os.getpid(), signal.SIGINT)
+        assert signal.getsignal(signal.SIGTERM) is mine
+        assert signal.getsignal(signal.SIGINT) is before[signal.SIGINT]
+        assert signal.getsignal(signal.SIGHUP) is before[signal.SIGHUP]
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
+
+
+def test_a_finished_run_leaves_the_signal_handlers_as_they_were(tmp_path):
+    import signal
+
+    before = signal.getsignal(signal.SIGINT)
+    exp = write_experiment(tmp_path)
+    assert evolve_main([str(exp), "--out", str(tmp_path / "run"), "--workers", "1", "--no-progress",
+                        "--generations", "1"]) == 0
+    assert signal.getsignal(signal.SIGINT) is before

@@ -40,6 +40,7 @@ from evolution.run.rebuild import RebuildingEvaluator, load_record
 from evolution.run.recorder import RunRecorder, convergence_target
 from evolution.run.reuse import ReusingEvaluator
 from evolution.run.rundir import check_new_run_dir, new_run, restore_run
+from evolution.run.signals import StopSignals
 from gathering_env.compiled.engine import announce_compile
 
 
@@ -139,7 +140,7 @@ class Trainer:
 
     SIGINT/SIGTERM/SIGHUP: the first signal lets the current generation finish (its statistics and
     checkpoint are written) and then stops; a second one abandons the generation at once. Either
-    way the run resumes from its last checkpoint.
+    way the run resumes from its last checkpoint (``evolution.run.signals``).
     """
 
     def __init__(self, experiment: Experiment | None, run_dir: Path, workers: int | None = None,
@@ -164,7 +165,7 @@ class Trainer:
         self.ray_address = ray_address
         self.max_retries = max_retries
         self.overrides = overrides
-        self.stop_requested = False
+        self.stop = StopSignals(lambda: getattr(self, "_generation", 0))
         self.recorder: RunRecorder | None = None
         self._current: dict[int, Evaluation] = {}
         self._current_genomes: dict[int, Any] = {}
@@ -204,7 +205,6 @@ class Trainer:
     def _run(self) -> RunResult:
         population, finished, write = self._prepare()
         exp, recorder, lock = self.experiment, self.recorder, self._lock
-        target = convergence_target(exp)
         if finished:
             # Nothing left to evolve: only rebuild what is missing.
             lock.acquire()
@@ -214,7 +214,6 @@ class Trainer:
             if not (self.run_dir / "stats.png").exists():
                 recorder.plot()
             return self._result(recorder.converged(), already_finished=True)
-        converged = False
         recorded = load_record(self.rebuild_from, exp.to_dict()) if self.rebuild_from is not None else None
         context = EvalContext(recorder.config, training_environment(exp.environment, exp.seed, exp.layout),
                               exp.trials, exp.seed, exp.method,
@@ -242,46 +241,18 @@ class Trainer:
         except BaseException:
             evaluator.close()
             raise
-        previous_handlers = self._install_signal_handlers()
         bar = None
         if self.progress:
             from tqdm import tqdm
 
             bar = tqdm(total=exp.generations, initial=population.generation, desc=exp.name, unit="gen")
         try:
-            while population.generation < exp.generations:
-                generation = population.generation
-                start = time.perf_counter()
-                species_count = len(population.species.species)
-                history = getattr(population.species, "history", None)
-                threshold = history[-1][1] if history else population.species.species_set_config.compatibility_threshold
-
-                self._generation = generation
-                self._population = population
-                rebuilt = recorded is not None and evaluator.rebuilds(generation)
-                amend = evaluator.check if rebuilt else None
-                population.run(self._fitness, 1)
-                if getattr(population.species, "deferred", False):  # speciated once scored, in the run
-                    _, threshold, species_count = population.species.history[-1]
-                self._check_run_dir(generation)
-                record = recorder.record(population, generation, species_count, time.perf_counter() - start,
-                                         self._current, self._current_genomes, self._failures, threshold,
-                                         self._carried, amend)
-                recorder.save_checkpoint(population)
-                if bar is not None:
-                    bar.set_postfix(best_ft=f"{record['task_best']:.1f}", mean_ft=f"{record['task_mean']:.1f}")
-                    bar.update(1)
-                if (exp.convergence_stop and not exp.multi_objective and record["task_best"] >= target):
-                    converged = True
-                    break
-                if self.stop_requested:
-                    break
-            self._check_run_dir(population.generation)
+            with self.stop:
+                converged = self._evolve(population, evaluator, recorded, bar)
         except OSError as err:
             raise RunFailed(f"{describe_os_error(err)}; the run stopped at generation {population.generation}: "
                             f"fix it and continue with gathering-evolve --resume {self.run_dir}") from None
         finally:
-            self._restore_signal_handlers(previous_handlers)
             evaluator.close()
             if bar is not None:
                 bar.close()
@@ -289,7 +260,41 @@ class Trainer:
             recorder.write_front(population)
         recorder.plot()
         self._check_run_dir(population.generation)
-        return self._result(converged, interrupted=self.stop_requested)
+        return self._result(converged, interrupted=self.stop.requested)
+
+    def _evolve(self, population: neat.Population, evaluator: Any, recorded: Any, bar: Any) -> bool:
+        """Run generations until the limit, convergence (returns True) or a stop signal."""
+        exp, recorder = self.experiment, self.recorder
+        target = convergence_target(exp)
+        while population.generation < exp.generations:
+            generation = population.generation
+            start = time.perf_counter()
+            species_count = len(population.species.species)
+            history = getattr(population.species, "history", None)
+            threshold = history[-1][1] if history else population.species.species_set_config.compatibility_threshold
+
+            self._generation = generation
+            self._population = population
+            rebuilt = recorded is not None and evaluator.rebuilds(generation)
+            amend = evaluator.check if rebuilt else None
+            population.run(self._fitness, 1)
+            if getattr(population.species, "deferred", False):  # speciated once scored, in the run
+                _, threshold, species_count = population.species.history[-1]
+            self._check_run_dir(generation)
+            record = recorder.record(population, generation, species_count, time.perf_counter() - start,
+                                     self._current, self._current_genomes, self._failures, threshold,
+                                     self._carried, amend)
+            recorder.save_checkpoint(population)
+            if bar is not None:
+                bar.set_postfix(best_ft=f"{record['task_best']:.1f}", mean_ft=f"{record['task_mean']:.1f}")
+                bar.update(1)
+            if exp.convergence_stop and not exp.multi_objective and record["task_best"] >= target:
+                self._check_run_dir(population.generation)
+                return True
+            if self.stop.requested:
+                break
+        self._check_run_dir(population.generation)
+        return False
 
     def _check_run_dir(self, generation: int) -> None:
         """Stop (no success reported) if the run directory was deleted or replaced under the run."""
@@ -309,32 +314,6 @@ class Trainer:
         return RunResult(self.run_dir, len(recorder.records), best, champion if champion.exists() else None, converged,
                          interrupted=interrupted, already_finished=already_finished,
                          reused=getattr(evaluator, "reused", 0), asked=getattr(evaluator, "asked", 0))
-
-    def _install_signal_handlers(self) -> dict[int, Any]:
-        import signal
-        import threading
-
-        if threading.current_thread() is not threading.main_thread():
-            return {}
-
-        def request_stop(signum: int, frame: Any) -> None:
-            if self.stop_requested:
-                raise KeyboardInterrupt  # second signal: abandon the generation in flight
-            self.stop_requested = True
-            print(f"\nsignal {signum}: finishing generation {getattr(self, '_generation', 0)}, then stopping "
-                  "(again to abandon it); resume with --resume", flush=True)
-
-        previous = {}
-        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):  # SIGHUP: the terminal closed
-            previous[sig] = signal.signal(sig, request_stop)
-        return previous
-
-    @staticmethod
-    def _restore_signal_handlers(previous: dict[int, Any]) -> None:
-        import signal
-
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
 
     def _fitness(self, genomes: list[tuple[int, Any]], config: neat.Config) -> None:
         """neat-python fitness function: evaluate on the backend, set fitness and objectives.
