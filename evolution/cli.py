@@ -54,6 +54,39 @@ def _dump_preset(name: str) -> int:
 @command
 def evolve_main(argv: list[str] | None = None) -> int:
     """``gathering-evolve [PRESET | EXPERIMENT.toml] [overrides] --out RUN_DIR``."""
+    args = _evolve_parser().parse_args(argv)
+    if args.ray_address is not None and args.backend != "ray":
+        raise UsageError(f"--ray-address {args.ray_address}: only used with --backend ray (the backend is "
+                         f"{args.backend}); allowed: add --backend ray, or drop --ray-address")
+    if args.list:
+        return _list_presets()
+    if args.dump is not None:
+        try:
+            return _dump_preset(args.dump)
+        except ValueError as err:
+            raise UsageError(f"--dump {err}") from None
+    overrides = _evolve_overrides(args)
+    resume = args.resume is not None or args.resume_from is not None
+    out, experiment = _run_dir_and_experiment(args, overrides, resume)
+    from evolution.run.trainer import Trainer
+
+    trainer = Trainer(experiment, out, workers=args.workers, resume=resume,
+                      resume_from=args.resume_from, progress=not args.no_progress,
+                      backend=args.backend, ray_address=args.ray_address, max_retries=args.max_retries,
+                      overrides=overrides, rebuild_from=args.rebuild_from)
+    try:
+        result = trainer.run()
+    except KeyboardInterrupt:
+        print(f"\ninterrupted: resume with gathering-evolve --resume {out}", file=sys.stderr)
+        return 130
+    if result.interrupted:
+        print(f"stopped after {result.generations} generations; resume with: gathering-evolve --resume {out}")
+        return 130
+    return _report_run(result, out, trainer.experiment.generations)
+
+
+def _evolve_parser() -> ArgumentParser:
+    """The ``gathering-evolve`` command line."""
     from gathering_env import __version__
 
     parser = ArgumentParser(
@@ -102,34 +135,31 @@ def evolve_main(argv: list[str] | None = None) -> int:
     group.add_argument("--environment", type=int, help="environment preset 1, 2 or 3 (paper Table 2)")
     group.add_argument("--steps", type=int, help="steps per trial (max_cycles)")
     group.add_argument("--robots", type=int, help="team size (num_robots)")
-    args = parser.parse_args(argv)
-    if args.ray_address is not None and args.backend != "ray":
-        raise UsageError(f"--ray-address {args.ray_address}: only used with --backend ray (the backend is "
-                         f"{args.backend}); allowed: add --backend ray, or drop --ray-address")
-    if args.list:
-        return _list_presets()
-    if args.dump is not None:
-        try:
-            return _dump_preset(args.dump)
-        except ValueError as err:
-            raise UsageError(f"--dump {err}") from None
+    return parser
+
+
+def _evolve_overrides(args) -> dict:
+    """The command line's overrides of the experiment file (``None``: not given); resolves a preset name."""
     preset_overrides: dict = {}
     if args.experiment is not None:
         if is_preset_name(args.experiment):
             args.experiment, preset_overrides = resolve_preset(args.experiment)
         else:
             args.experiment = Path(args.experiment)
-
-    overrides = {
+    return {
         **preset_overrides,
         "protocol": args.protocol if args.protocol is not None else preset_overrides.get("protocol"),
-        "name": args.name if args.name is not None else preset_overrides.get("name"), "method": args.method, "seed": args.seed, "generations": args.generations,
+        "name": args.name if args.name is not None else preset_overrides.get("name"), "method": args.method,
+        "seed": args.seed, "generations": args.generations,
         "population": args.population, "trials": args.trials,
         "objectives": [o.strip() for o in args.objectives.split(",")] if args.objectives is not None else None,
         "environment.environment": args.environment, "environment.max_cycles": args.steps,
         "environment.num_robots": args.robots,
     }
-    resume = args.resume is not None or args.resume_from is not None
+
+
+def _run_dir_and_experiment(args, overrides: dict, resume: bool):
+    """The run directory and the experiment (``None``: the resumed run's own) the arguments name."""
     out = args.out
     if args.resume is True and out is None and args.experiment is not None and args.experiment.is_dir():
         out, args.experiment = args.experiment, None  # gathering-evolve RUN_DIR --resume
@@ -160,22 +190,13 @@ def evolve_main(argv: list[str] | None = None) -> int:
     else:
         experiment = load_experiment(args.experiment, overrides)
         out = out or Path("runs") / f"{experiment.name}-seed{experiment.seed}"
-    from evolution.run.trainer import Trainer
+    return out, experiment
 
-    trainer = Trainer(experiment, out, workers=args.workers, resume=resume,
-                      resume_from=args.resume_from, progress=not args.no_progress,
-                      backend=args.backend, ray_address=args.ray_address, max_retries=args.max_retries,
-                      overrides=overrides, rebuild_from=args.rebuild_from)
-    try:
-        result = trainer.run()
-    except KeyboardInterrupt:
-        print(f"\ninterrupted: resume with gathering-evolve --resume {out}", file=sys.stderr)
-        return 130
-    if result.interrupted:
-        print(f"stopped after {result.generations} generations; resume with: gathering-evolve --resume {out}")
-        return 130
+
+def _report_run(result, out: Path, generations: int) -> int:
+    """Print how a run that was not interrupted ended."""
     if result.already_finished:
-        why = "converged" if result.converged else f"reached its {trainer.experiment.generations} generations"
+        why = "converged" if result.converged else f"reached its {generations} generations"
         print(f"{out}: already finished ({why}: {result.generations} generations, best ft {result.best_task:.2f}); "
               "nothing to evolve (raise --generations to continue it)")
         return 0

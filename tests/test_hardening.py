@@ -208,7 +208,7 @@ def test_orphaned_workers_exit_after_the_trainer_is_sigkilled(tmp_path):
 # ---------------------------------------------------------------- tracebacks
 @pytest.mark.parametrize("case", ["out-is-file", "out-under-file", "experiment-is-dir", "champion-is-dir",
                                   "analyze-file", "frame-every-0", "compare-episodes-0", "resume-from-dir",
-                                  "png-suffix"])
+                                  "png-suffix", "resume-which-run", "resume-two-dirs"])
 def test_unusable_paths_and_options_are_one_line_errors(finished, tmp_path, capsys, case):
     exp, run = finished
     a_file = tmp_path / "a_file"
@@ -223,6 +223,8 @@ def test_unusable_paths_and_options_are_one_line_errors(finished, tmp_path, caps
         "compare-episodes-0": (compare_main, ["--policy", "random", "--episodes", "0"], "--episodes"),
         "resume-from-dir": (evolve_main, ["--resume-from", str(run)], "--resume-from"),
         "png-suffix": (replay_main, [str(run / "champion.json"), "--png", str(tmp_path / "x.jpg")], "--png"),
+        "resume-which-run": (evolve_main, ["--resume"], "--resume: which run?"),
+        "resume-two-dirs": (evolve_main, ["--resume", str(run), "--out", str(tmp_path / "r")], "differs from --out"),
     }[case]
     assert call(main, args) == 2
     assert needle in one_error_line(capsys)
