@@ -40,6 +40,14 @@ GROUND_FRICTIONS: tuple[str, str] = ("threshold", "mass")
 DRIVE_MODELS: tuple[str, str] = ("velocity", "force")
 #: When robots act relative to the physics step (``WorldConfig.schedule``, ``gathering_env.drive``).
 SCHEDULES: tuple[str, str] = ("fixed", "shuffled")
+#: Every field that takes one of a few names -> the names it takes (the first is the default).
+CHOICES: dict[str, tuple[str, ...]] = {
+    "kernel": KERNELS, "reward": REWARDS, "reward_scope": REWARD_SCOPES, "pickup_box": PICKUP_BOXES,
+    "ground_friction": GROUND_FRICTIONS, "drive_model": DRIVE_MODELS, "schedule": SCHEDULES,
+    "ir_response": ("linear", "gamma", "khepera"), "bottom_response": ("linear", "khepera"),
+    "wall_distance": ("nearest", "original"), "block_sighting": ("cone", "rays"),
+    "colour_response": ("nearer", "farther"),
+}
 GRAVITY = 9.81
 """Acceleration of gravity (units/s^2) that turns mass into ground friction ('mass')."""
 MASS_FRICTION = 0.1
@@ -252,82 +260,7 @@ class WorldConfig:
         return cls(environment=environment, **values)
 
     def __post_init__(self) -> None:
-        _check_int("num_robots", self.num_robots, 1, 1000)
-        _check_int("max_cycles", self.max_cycles, 1, 10**9)
-        _check_int("physics_iterations", self.physics_iterations, 1, 1000)
-        _check_int("physics_substeps", self.physics_substeps, 1, 100)
-        for name in (
-            "arena_width", "arena_height", "dt", "robot_radius", "robot_mass",
-            "robot_max_speed", "robot_drive_force", "robot_drive_torque",
-            "zone_width", "zone_depth", "pickup_box_width", "pickup_box_depth",
-            "pickup_reach", "collision_avoidance_distance", "ir_gamma", "bottom_falloff",
-        ):
-            _check_float(name, getattr(self, name), 0.0, math.inf, low_open=True)
-        for name in ("robot_friction", "block_friction", "time_bonus", "attach_reward"):
-            _check_float(name, getattr(self, name), 0.0, math.inf)
-        _check_float("drive_dead_band", self.drive_dead_band, 0.0, 1.0, high_open=True)
-        for name in ("robot_restitution", "block_restitution", "wall_restitution"):
-            _check_float(name, getattr(self, name), 0.0, 1.0)
-        _check_float("damping", self.damping, 0.0, 100.0)
-        _check_float("block_friction_margin", self.block_friction_margin, 0.0, 1.0,
-                     low_open=True, high_open=True)
-        for i, count in enumerate(self.block_counts):
-            _check_int(f"block_counts[{i}] ({BLOCK_TYPE_NAMES[i]})", count, 0, 10_000)
-        for i in range(3):
-            label = BLOCK_TYPE_NAMES[i]
-            _check_float(f"block_sizes[{i}] ({label})", self.block_sizes[i], 0.0, math.inf, low_open=True)
-            _check_float(f"block_masses[{i}] ({label})", self.block_masses[i], 0.0, math.inf, low_open=True)
-            _check_float(f"block_values[{i}] ({label})", self.block_values[i], 0.0, math.inf, low_open=True)
-            _check_int(f"robots_needed[{i}] ({label})", self.robots_needed[i], 1, 100)
-        if self.zone_width > self.arena_width:
-            raise ValueError(
-                f"zone_width={self.zone_width} must be <= arena_width={self.arena_width}"
-            )
-        if self.zone_depth >= self.arena_height:
-            raise ValueError(
-                f"zone_depth={self.zone_depth} must be < arena_height={self.arena_height}"
-            )
-        for name, value in (("pickup_heuristic", self.pickup_heuristic),
-                            ("weld_seat", self.weld_seat),
-                            ("collision_avoidance", self.collision_avoidance)):
-            if not isinstance(value, bool):
-                raise ValueError(f"{name}={value!r} must be a bool (True or False)")
-        if self.pickup_box not in PICKUP_BOXES:
-            raise ValueError(f"pickup_box={self.pickup_box!r}; allowed: {', '.join(map(repr, PICKUP_BOXES))}")
-        if self.ground_friction not in GROUND_FRICTIONS:
-            raise ValueError(f"ground_friction={self.ground_friction!r}; allowed: "
-                             f"{', '.join(map(repr, GROUND_FRICTIONS))}")
-        if self.drive_model not in DRIVE_MODELS:
-            raise ValueError(f"drive_model={self.drive_model!r}; allowed: "
-                             f"{', '.join(map(repr, DRIVE_MODELS))}")
-        if self.drive_model == "force" and self.drive_dead_band != 0.0:
-            raise ValueError(f"drive_dead_band={self.drive_dead_band!r} with drive_model='force': "
-                             "the force drive has its own dead band; allowed: 0")
-        if self.layout_seed is not None:
-            _check_int("layout_seed", self.layout_seed, 0, 2 ** 63 - 1)
-        if self.schedule not in SCHEDULES:
-            raise ValueError(f"schedule={self.schedule!r}; allowed: {', '.join(map(repr, SCHEDULES))}")
-        if self.schedule == "shuffled" and self.drive_model != "force":
-            raise ValueError(f"schedule='shuffled' with drive_model={self.drive_model!r}: the shuffled "
-                             "schedule acts on wheel forces; allowed: drive_model='force', or schedule='fixed'")
-        if self.ir_response not in ("linear", "gamma", "khepera"):
-            raise ValueError(f"ir_response={self.ir_response!r}; allowed: 'linear', 'gamma', 'khepera'")
-        if self.bottom_response not in ("linear", "khepera"):
-            raise ValueError(f"bottom_response={self.bottom_response!r}; allowed: 'linear', 'khepera'")
-        if self.wall_distance not in ("nearest", "original"):
-            raise ValueError(f"wall_distance={self.wall_distance!r}; allowed: 'nearest', 'original'")
-        if self.block_sighting not in ("cone", "rays"):
-            raise ValueError(f"block_sighting={self.block_sighting!r}; allowed: 'cone', 'rays'")
-        if self.colour_response not in ("nearer", "farther"):
-            raise ValueError(f"colour_response={self.colour_response!r}; allowed: 'nearer', 'farther'")
-        if self.reward not in REWARDS:
-            raise ValueError(f"reward={self.reward!r}; allowed: {', '.join(map(repr, REWARDS))}")
-        if self.reward_scope not in REWARD_SCOPES:
-            raise ValueError(f"reward_scope={self.reward_scope!r}; allowed: {', '.join(map(repr, REWARD_SCOPES))}")
-        if self.kernel not in KERNELS:
-            raise ValueError(f"kernel={self.kernel!r}; allowed: {', '.join(map(repr, KERNELS))}")
-        if sum(self.block_counts) == 0:
-            raise ValueError("block_counts=(0, 0, 0): the world needs at least one block")
+        _validate(self)
 
     # --- derived quantities -----------------------------------------------------------
     @property
@@ -367,6 +300,63 @@ class WorldConfig:
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe dict of every field (tuples become lists)."""
         return {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()}
+
+
+def _validate(config: WorldConfig) -> None:
+    """Raise ``ValueError`` naming the first field of ``config`` that is out of range."""
+    _check_int("num_robots", config.num_robots, 1, 1000)
+    _check_int("max_cycles", config.max_cycles, 1, 10**9)
+    _check_int("physics_iterations", config.physics_iterations, 1, 1000)
+    _check_int("physics_substeps", config.physics_substeps, 1, 100)
+    for name in (
+        "arena_width", "arena_height", "dt", "robot_radius", "robot_mass",
+        "robot_max_speed", "robot_drive_force", "robot_drive_torque",
+        "zone_width", "zone_depth", "pickup_box_width", "pickup_box_depth",
+        "pickup_reach", "collision_avoidance_distance", "ir_gamma", "bottom_falloff",
+    ):
+        _check_float(name, getattr(config, name), 0.0, math.inf, low_open=True)
+    for name in ("robot_friction", "block_friction", "time_bonus", "attach_reward"):
+        _check_float(name, getattr(config, name), 0.0, math.inf)
+    _check_float("drive_dead_band", config.drive_dead_band, 0.0, 1.0, high_open=True)
+    for name in ("robot_restitution", "block_restitution", "wall_restitution"):
+        _check_float(name, getattr(config, name), 0.0, 1.0)
+    _check_float("damping", config.damping, 0.0, 100.0)
+    _check_float("block_friction_margin", config.block_friction_margin, 0.0, 1.0,
+                 low_open=True, high_open=True)
+    for i, count in enumerate(config.block_counts):
+        _check_int(f"block_counts[{i}] ({BLOCK_TYPE_NAMES[i]})", count, 0, 10_000)
+    for i in range(3):
+        label = BLOCK_TYPE_NAMES[i]
+        _check_float(f"block_sizes[{i}] ({label})", config.block_sizes[i], 0.0, math.inf, low_open=True)
+        _check_float(f"block_masses[{i}] ({label})", config.block_masses[i], 0.0, math.inf, low_open=True)
+        _check_float(f"block_values[{i}] ({label})", config.block_values[i], 0.0, math.inf, low_open=True)
+        _check_int(f"robots_needed[{i}] ({label})", config.robots_needed[i], 1, 100)
+    if config.zone_width > config.arena_width:
+        raise ValueError(
+            f"zone_width={config.zone_width} must be <= arena_width={config.arena_width}"
+        )
+    if config.zone_depth >= config.arena_height:
+        raise ValueError(
+            f"zone_depth={config.zone_depth} must be < arena_height={config.arena_height}"
+        )
+    for name, value in (("pickup_heuristic", config.pickup_heuristic),
+                        ("weld_seat", config.weld_seat),
+                        ("collision_avoidance", config.collision_avoidance)):
+        if not isinstance(value, bool):
+            raise ValueError(f"{name}={value!r} must be a bool (True or False)")
+    for name, allowed in CHOICES.items():
+        if getattr(config, name) not in allowed:
+            raise ValueError(f"{name}={getattr(config, name)!r}; allowed: {', '.join(map(repr, allowed))}")
+    if config.drive_model == "force" and config.drive_dead_band != 0.0:
+        raise ValueError(f"drive_dead_band={config.drive_dead_band!r} with drive_model='force': "
+                         "the force drive has its own dead band; allowed: 0")
+    if config.layout_seed is not None:
+        _check_int("layout_seed", config.layout_seed, 0, 2 ** 63 - 1)
+    if config.schedule == "shuffled" and config.drive_model != "force":
+        raise ValueError(f"schedule='shuffled' with drive_model={config.drive_model!r}: the shuffled "
+                         "schedule acts on wheel forces; allowed: drive_model='force', or schedule='fixed'")
+    if sum(config.block_counts) == 0:
+        raise ValueError("block_counts=(0, 0, 0): the world needs at least one block")
 
 
 def _triple(name: str, value: Any) -> tuple:
