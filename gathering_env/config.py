@@ -40,7 +40,7 @@ GROUND_FRICTIONS: tuple[str, str] = ("threshold", "mass")
 DRIVE_MODELS: tuple[str, str] = ("velocity", "force")
 #: When robots act relative to the physics step (``WorldConfig.schedule``, ``gathering_env.drive``).
 SCHEDULES: tuple[str, str] = ("fixed", "shuffled")
-#: Every field that takes one of a few names -> the names it takes (the first is the default).
+#: Every field that takes one of a few names -> the names it takes (its default is on the field).
 CHOICES: dict[str, tuple[str, ...]] = {
     "kernel": KERNELS, "reward": REWARDS, "reward_scope": REWARD_SCOPES, "pickup_box": PICKUP_BOXES,
     "ground_friction": GROUND_FRICTIONS, "drive_model": DRIVE_MODELS, "schedule": SCHEDULES,
