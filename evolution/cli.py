@@ -24,6 +24,7 @@ from evolution.run.presets import (
     resolve_preset,
 )
 from evolution.run.protocol import DESCRIPTIONS, PROTOCOLS, newest_version
+from gathering_env.config import ENVIRONMENT_PRESETS, INT_RANGES
 
 MAX_WORKERS = max(4, 4 * (os.cpu_count() or 1))
 """Most evaluation processes ``--workers`` may ask for: four per core (each worker holds its own
@@ -132,9 +133,10 @@ def _evolve_parser() -> ArgumentParser:
     group.add_argument("--population", type=int_arg(*LIMITS["population"]), help="genomes per generation")
     group.add_argument("--trials", type=int_arg(*LIMITS["trials"]),
                        help="episodes per genome; its fitness is their mean ft")
-    group.add_argument("--environment", type=int, help="environment preset 1, 2 or 3 (paper Table 2)")
-    group.add_argument("--steps", type=int, help="steps per trial (max_cycles)")
-    group.add_argument("--robots", type=int, help="team size (num_robots)")
+    group.add_argument("--environment", type=int, choices=tuple(ENVIRONMENT_PRESETS),
+                       help="environment preset 1, 2 or 3 (paper Table 2)")
+    group.add_argument("--steps", type=int_arg(*INT_RANGES["max_cycles"]), help="steps per trial (max_cycles)")
+    group.add_argument("--robots", type=int_arg(*INT_RANGES["num_robots"]), help="team size (num_robots)")
     return parser
 
 
@@ -224,9 +226,9 @@ def replay_main(argv: list[str] | None = None) -> int:
                             description="Replay an evolved team or any named policy and save the episode as GIF/MP4 "
                                         "(pictures: --png, --strip, --sensors-png; see docs/rendering.md).")
     parser.add_argument("team", help=f"champion JSON written by gathering-evolve, or a policy name: {POLICY_NAMES}")
-    parser.add_argument("--environment", type=int, choices=(1, 2, 3),
+    parser.add_argument("--environment", type=int, choices=tuple(ENVIRONMENT_PRESETS),
                         help="preset (default: the one it evolved or was trained in; else 2)")
-    parser.add_argument("--steps", type=int_arg(1, 10**9),
+    parser.add_argument("--steps", type=int_arg(*INT_RANGES["max_cycles"]),
                         help="episode length (default: the evolved or trained max_cycles; else 10 000)")
     parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0,
                         help="the episode's seed (default 0): an episode the team was not trained on")

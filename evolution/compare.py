@@ -38,6 +38,7 @@ from evolution.run.experiment import LIMITS
 from evolution.run.lock import LOCK_FILE, RunLock
 from evolution.run.protocol import PROTOCOLS, protocol_values
 from gathering_env import WorldConfig, parallel_env
+from gathering_env.config import ENVIRONMENT_PRESETS, INT_RANGES
 
 
 def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
@@ -199,11 +200,11 @@ def compare_main(argv: list[str] | None = None) -> int:
                             formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--policy", action="append", required=True,
                         help=f"{POLICY_NAMES.replace(', ', ' | ')} (repeat)")
-    parser.add_argument("--environment", type=int, choices=(1, 2, 3),
+    parser.add_argument("--environment", type=int, choices=tuple(ENVIRONMENT_PRESETS),
                         help="environment preset (paper Table 2; default 2, or --world-from's)")
-    parser.add_argument("--steps", type=int_arg(1, 10**9),
+    parser.add_argument("--steps", type=int_arg(*INT_RANGES["max_cycles"]),
                         help="max_cycles per episode (default 10000, or --world-from's)")
-    parser.add_argument("--robots", type=int_arg(1, 1000), help="team size (default 20, or --world-from's)")
+    parser.add_argument("--robots", type=int_arg(*INT_RANGES["num_robots"]), help="team size (default 20, or --world-from's)")
     parser.add_argument("--episodes", type=int_arg(1, 10_000), default=5, help="episodes (seeds 0..n-1) per policy")
     parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0, help="first episode seed")
     parser.add_argument("--protocol", choices=PROTOCOLS, default=None,

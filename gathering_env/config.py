@@ -48,6 +48,12 @@ CHOICES: dict[str, tuple[str, ...]] = {
     "wall_distance": ("nearest", "original"), "block_sighting": ("cone", "rays"),
     "colour_response": ("nearer", "farther"),
 }
+INT_RANGES: dict[str, tuple[int, int]] = {
+    "num_robots": (1, 1000), "max_cycles": (1, 10**9),
+    "physics_iterations": (1, 1000), "physics_substeps": (1, 100),
+}
+"""Integer fields -> their allowed [low, high]; command-line flags that set them take the same range."""
+
 GRAVITY = 9.81
 """Acceleration of gravity (units/s^2) that turns mass into ground friction ('mass')."""
 MASS_FRICTION = 0.1
@@ -304,10 +310,8 @@ class WorldConfig:
 
 def _validate(config: WorldConfig) -> None:
     """Raise ``ValueError`` naming the first field of ``config`` that is out of range."""
-    _check_int("num_robots", config.num_robots, 1, 1000)
-    _check_int("max_cycles", config.max_cycles, 1, 10**9)
-    _check_int("physics_iterations", config.physics_iterations, 1, 1000)
-    _check_int("physics_substeps", config.physics_substeps, 1, 100)
+    for name, (low, high) in INT_RANGES.items():
+        _check_int(name, getattr(config, name), low, high)
     for name in (
         "arena_width", "arena_height", "dt", "robot_radius", "robot_mass",
         "robot_max_speed", "robot_drive_force", "robot_drive_torque",

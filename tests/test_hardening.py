@@ -208,7 +208,8 @@ def test_orphaned_workers_exit_after_the_trainer_is_sigkilled(tmp_path):
 # ---------------------------------------------------------------- tracebacks
 @pytest.mark.parametrize("case", ["out-is-file", "out-under-file", "experiment-is-dir", "champion-is-dir",
                                   "analyze-file", "frame-every-0", "compare-episodes-0", "resume-from-dir",
-                                  "png-suffix", "resume-which-run", "resume-two-dirs"])
+                                  "png-suffix", "resume-which-run", "resume-two-dirs", "evolve-steps-0",
+                                  "evolve-robots-0", "evolve-environment-7"])
 def test_unusable_paths_and_options_are_one_line_errors(finished, tmp_path, capsys, case):
     exp, run = finished
     a_file = tmp_path / "a_file"
@@ -225,6 +226,11 @@ def test_unusable_paths_and_options_are_one_line_errors(finished, tmp_path, caps
         "png-suffix": (replay_main, [str(run / "champion.json"), "--png", str(tmp_path / "x.jpg")], "--png"),
         "resume-which-run": (evolve_main, ["--resume"], "--resume: which run?"),
         "resume-two-dirs": (evolve_main, ["--resume", str(run), "--out", str(tmp_path / "r")], "differs from --out"),
+        # a world override names its flag, not the experiment file's key
+        "evolve-steps-0": (evolve_main, [str(exp), "--steps", "0", "--out", str(tmp_path / "r")], "--steps"),
+        "evolve-robots-0": (evolve_main, [str(exp), "--robots", "0", "--out", str(tmp_path / "r")], "--robots"),
+        "evolve-environment-7": (evolve_main, [str(exp), "--environment", "7", "--out", str(tmp_path / "r")],
+                                 "--environment"),
     }[case]
     assert call(main, args) == 2
     assert needle in one_error_line(capsys)
