@@ -46,7 +46,7 @@ from evolution.compare import compare  # noqa: E402
 from evolution.guard import ArgumentParser, UsageError, check_output_dir, command, float_arg, int_arg  # noqa: E402
 from evolution.policies.marl import GROUP, benchmarl_policy, save_policy  # noqa: E402
 from gathering_env import Morphology  # noqa: E402
-from gathering_env.config import REWARD_SCOPES, REWARDS, WorldConfig  # noqa: E402
+from gathering_env.config import ENVIRONMENT_PRESETS, REWARD_SCOPES, REWARDS, WorldConfig  # noqa: E402
 from gathering_env.rl.benchmarl_task import GatheringTask, check_task_config  # noqa: E402
 
 ALGORITHMS = {"ippo": IppoConfig, "mappo": MappoConfig, "iddpg": IddpgConfig, "maddpg": MaddpgConfig,
@@ -117,7 +117,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p = ArgumentParser(prog="benchmarl_run.py", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     count = int_arg(1, float("inf"))
     p.add_argument("--algorithm", choices=sorted(ALGORITHMS), default="mappo")
-    p.add_argument("--environment", type=int, default=1, choices=(1, 2, 3))
+    p.add_argument("--environment", type=int, default=1, choices=tuple(ENVIRONMENT_PRESETS))
     p.add_argument("--steps", type=count, default=2000, help="episode length (max_cycles) while training")
     p.add_argument("--robots", type=count, default=20)
     p.add_argument("--worlds", type=count, default=4, help="worlds stepped together (BenchMARL's envs per worker)")

@@ -14,12 +14,13 @@ from pathlib import Path
 import numpy as np
 
 from gathering_env import parallel_env
+from gathering_env.config import ENVIRONMENT_PRESETS
 from gathering_env.render import save_video
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--environment", type=int, default=2, choices=(1, 2, 3))
+    parser.add_argument("--environment", type=int, default=2, choices=tuple(ENVIRONMENT_PRESETS))
     parser.add_argument("--steps", type=int, default=600, help="episode length (max_cycles)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--frame-every", type=int, default=5, help="record every k-th step")

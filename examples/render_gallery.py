@@ -21,6 +21,7 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
 from evolution.run.champion import ChampionError, load_champion  # noqa: E402
 from gathering_env import Morphology, SensorSpec, parallel_env  # noqa: E402
+from gathering_env.config import ENVIRONMENT_PRESETS  # noqa: E402
 from gathering_env.render import Renderer, film_strip, save_png, sensor_layout  # noqa: E402
 
 NAMES = ("default", "cameras-auto", "cameras-all", "cones-robots", "zone", "follow", "trail", "small", "strip", "sensors", "human")
@@ -45,7 +46,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("champion", type=Path)
     parser.add_argument("--out", type=Path, default=Path("gallery"))
-    parser.add_argument("--environment", type=int, default=1, choices=(1, 2, 3))
+    parser.add_argument("--environment", type=int, default=1, choices=tuple(ENVIRONMENT_PRESETS))
     parser.add_argument("--seed", type=int, default=3)
     parser.add_argument("--step", type=int, default=600, help="the step every single picture shows")
     parser.add_argument("--steps", type=int, default=1200, help="episode length (the film strip's last step)")

@@ -57,7 +57,7 @@ from evolution.guard import (  # noqa: E402
 from evolution.policies.learned import ppo_policy  # noqa: E402
 from evolution.run.champion import load_champion  # noqa: E402
 from gathering_env import Morphology  # noqa: E402
-from gathering_env.config import REWARD_SCOPES, REWARDS, WorldConfig  # noqa: E402
+from gathering_env.config import ENVIRONMENT_PRESETS, REWARD_SCOPES, REWARDS, WorldConfig  # noqa: E402
 from gathering_env.rl.sb3 import MAX_WHEEL_LEVELS, GatheringVecEnv  # noqa: E402
 
 DEFAULT_ENV_STEPS = 500_000
@@ -139,7 +139,7 @@ def plot_curve(rows: list[dict], path: Path, title: str) -> None:
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p = ArgumentParser(prog="rl_ppo.py", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     count = int_arg(1, float("inf"))
-    p.add_argument("--environment", type=int, default=1, choices=(1, 2, 3))
+    p.add_argument("--environment", type=int, default=1, choices=tuple(ENVIRONMENT_PRESETS))
     p.add_argument("--steps", type=count, default=2000, help="episode length (max_cycles) while training")
     p.add_argument("--eval-steps", type=count, default=None, help="episode length for the evaluation (default: --steps)")
     p.add_argument("--robots", type=count, default=20)
