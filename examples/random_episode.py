@@ -9,24 +9,33 @@ it and push it towards the zone; random driving alone rarely gathers much.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
 
+from evolution.guard import ArgumentParser, check_output_file, command, int_arg
+from evolution.run.experiment import LIMITS
 from gathering_env import parallel_env
-from gathering_env.config import ENVIRONMENT_PRESETS
-from gathering_env.render import save_video
+from gathering_env.config import ENVIRONMENT_PRESETS, INT_RANGES
+from gathering_env.render import save_png, save_video
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+@command
+def main(argv: list[str] | None = None) -> int:
+    parser = ArgumentParser(prog="random_episode.py", description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--environment", type=int, default=2, choices=tuple(ENVIRONMENT_PRESETS))
-    parser.add_argument("--steps", type=int, default=600, help="episode length (max_cycles)")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--frame-every", type=int, default=5, help="record every k-th step")
+    parser.add_argument("--steps", type=int_arg(*INT_RANGES["max_cycles"]), default=600,
+                        help="episode length (max_cycles)")
+    parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0)
+    parser.add_argument("--frame-every", type=int_arg(1, float("inf")), default=5, help="record every k-th step")
     parser.add_argument("--out", type=Path, default=Path("out/random_episode.gif"), help=".gif or .mp4")
     parser.add_argument("--png", type=Path, help="also save the last frame as a PNG picture")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    check_output_file(args.out, (".gif", ".mp4"), "--out")
+    if args.png is not None:
+        check_output_file(args.png, (".png",), "--png")
 
     env = parallel_env(environment=args.environment, max_cycles=args.steps, render_mode="rgb_array")
     env.reset(seed=args.seed)
@@ -43,17 +52,15 @@ def main() -> None:
     env.close()
     info = infos["robot_0"]
     path = save_video(frames, args.out, fps=15)
-    if args.png:
-        import imageio.v2 as imageio
-
-        args.png.parent.mkdir(parents=True, exist_ok=True)
-        imageio.imwrite(args.png, frames[-1])
+    if args.png is not None:
+        save_png(frames[-1], args.png)
     print(f"environment {args.environment}, {t} steps, random actions")
     print(f"gathered value {info['gathered_value']:.0f} / {info['total_value']:.0f} "
           f"(blocks by type {info['blocks_gathered_by_type']}), summed reward {total_reward:.1f}, "
           f"task performance ft = {info['task_performance']:.1f}")
     print(f"wrote {path} ({len(frames)} frames)")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -19,9 +19,11 @@ import numpy as np
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
+from evolution.guard import ArgumentParser, UsageError, command, int_arg  # noqa: E402
 from evolution.run.champion import ChampionError, load_champion  # noqa: E402
+from evolution.run.experiment import LIMITS  # noqa: E402
 from gathering_env import Morphology, SensorSpec, parallel_env  # noqa: E402
-from gathering_env.config import ENVIRONMENT_PRESETS  # noqa: E402
+from gathering_env.config import ENVIRONMENT_PRESETS, INT_RANGES  # noqa: E402
 from gathering_env.render import Renderer, film_strip, save_png, sensor_layout  # noqa: E402
 
 NAMES = ("default", "cameras-auto", "cameras-all", "cones-robots", "zone", "follow", "trail", "small", "strip", "sensors", "human")
@@ -42,19 +44,25 @@ def ten_cameras(environment: int, seed: int) -> dict[str, np.ndarray]:
     return pictures
 
 
+@command
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = ArgumentParser(prog="render_gallery.py", description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("champion", type=Path)
     parser.add_argument("--out", type=Path, default=Path("gallery"))
     parser.add_argument("--environment", type=int, default=1, choices=tuple(ENVIRONMENT_PRESETS))
-    parser.add_argument("--seed", type=int, default=3)
-    parser.add_argument("--step", type=int, default=600, help="the step every single picture shows")
-    parser.add_argument("--steps", type=int, default=1200, help="episode length (the film strip's last step)")
+    parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=3)
+    parser.add_argument("--step", type=int_arg(*INT_RANGES["max_cycles"]), default=600,
+                        help="the step every single picture shows")
+    parser.add_argument("--steps", type=int_arg(*INT_RANGES["max_cycles"]), default=1200,
+                        help="episode length (the film strip's last step)")
     parser.add_argument("--force", action="store_true", help="replace existing pictures")
     args = parser.parse_args(argv)
     if not 0 < args.step <= args.steps:
         print(f"error: --step: {args.step} is outside the episode; allowed: 1..{args.steps}", file=sys.stderr)
         return 2
+    if args.out.exists() and not args.out.is_dir():
+        raise UsageError(f"--out {args.out}: is a file; allowed: a folder (missing, or holding earlier pictures)")
     paths = {name: args.out / f"render-{name}.png" for name in NAMES}
     existing = [str(p) for p in paths.values() if p.exists()]
     if existing and not args.force:

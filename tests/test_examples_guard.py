@@ -128,3 +128,39 @@ def test_a_folder_given_as_the_experiment_is_a_folder_not_an_unknown_preset(tmp_
     assert call(evolve_main, ["myrun", "--out", str(tmp_path / "r")]) == 2
     err = one_error_line(capsys)
     assert "myrun: is a folder; allowed: a TOML experiment file" in err and "unknown preset" not in err
+
+
+def load_script(name: str):
+    """An example script as a module (no optional dependency needed)."""
+    spec = importlib.util.spec_from_file_location(f"script_{name}", ROOT / "examples" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize("case", ["steps-negative", "frame-every-0", "out-foreign-gif", "png-foreign"])
+def test_random_episode_refuses_bad_input_in_one_line_and_keeps_files(tmp_path, capsys, case):
+    notes = tmp_path / "notes.gif"
+    notes.write_text("my notes")
+    picture = tmp_path / "mine.png"
+    picture.write_text("not a png")
+    out = ["--out", str(tmp_path / "new.gif")]
+    args, needle = {
+        "steps-negative": (["--steps", "-3", *out], "--steps: -3 is out of range"),
+        "frame-every-0": (["--frame-every", "0", *out], "--frame-every: 0 is out of range"),
+        "out-foreign-gif": (["--steps", "5", "--out", str(notes)], f"--out {notes}: exists and is not a .gif"),
+        "png-foreign": (["--steps", "5", *out, "--png", str(picture)], f"--png {picture}: exists and is not a .png"),
+    }[case]
+    assert call(load_script("random_episode").main, args) == 2
+    assert needle in one_error_line(capsys)
+    assert notes.read_text() == "my notes" and picture.read_text() == "not a png"
+    assert not (tmp_path / "new.gif").exists()
+
+
+def test_render_gallery_refuses_a_file_as_its_folder(champion_run, tmp_path, capsys):
+    a_file = tmp_path / "gallery"
+    a_file.write_text("mine")
+    main = load_script("render_gallery").main
+    assert main([str(champion_run / "champion.json"), "--out", str(a_file), "--steps", "20", "--step", "10"]) == 2
+    assert f"--out {a_file}: is a file" in one_error_line(capsys)
+    assert a_file.read_text() == "mine"
