@@ -20,7 +20,7 @@ import numpy as np
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 
 from evolution.guard import ArgumentParser, UsageError, command, int_arg  # noqa: E402
-from evolution.run.champion import ChampionError, load_champion  # noqa: E402
+from evolution.run.champion import load_champion  # noqa: E402
 from evolution.run.experiment import LIMITS  # noqa: E402
 from gathering_env import Morphology, SensorSpec, parallel_env  # noqa: E402
 from gathering_env.config import ENVIRONMENT_PRESETS, INT_RANGES  # noqa: E402
@@ -59,21 +59,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--force", action="store_true", help="replace existing pictures")
     args = parser.parse_args(argv)
     if not 0 < args.step <= args.steps:
-        print(f"error: --step: {args.step} is outside the episode; allowed: 1..{args.steps}", file=sys.stderr)
-        return 2
+        raise UsageError(f"--step: {args.step} is outside the episode; allowed: 1..{args.steps}")
     if args.out.exists() and not args.out.is_dir():
         raise UsageError(f"--out {args.out}: is a file; allowed: a folder (missing, or holding earlier pictures)")
     paths = {name: args.out / f"render-{name}.png" for name in NAMES}
     existing = [str(p) for p in paths.values() if p.exists()]
     if existing and not args.force:
-        print(f"error: --out: {existing[0]} exists; allowed: a folder without render-*.png, or --force",
-              file=sys.stderr)
-        return 2
-    try:
-        champion = load_champion(args.champion)
-    except ChampionError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
+        raise UsageError(f"--out: {existing[0]} exists; allowed: a folder without render-*.png, or --force")
+    champion = load_champion(args.champion)  # a ChampionError (a ValueError) is one line, exit 2
 
     env = parallel_env(environment=args.environment, max_cycles=args.steps, render_mode="rgb_array",
                        render_options={"trail": 200})

@@ -20,8 +20,10 @@ from evolution.cli import evolve_main, replay_main
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def load_example(name: str):
-    pytest.importorskip("stable_baselines3")
+def load_example(name: str, needs: str | None = None):
+    """An example script as a module; skipped when the optional package ``needs`` is missing."""
+    if needs is not None:
+        pytest.importorskip(needs)
     spec = importlib.util.spec_from_file_location(f"example_{name}", ROOT / "examples" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -58,7 +60,7 @@ def ppo_run(root: Path, evaluation: str = '{"train_steps": 40, "env_steps": 160,
     ("model-broken", "model.zip: not a readable"),
 ])
 def test_rl_figures_refuses_bad_input_in_one_line_before_work(champion_run, tmp_path, capsys, case, needle):
-    rl_figures = load_example("rl_figures")
+    rl_figures = load_example("rl_figures", needs="stable_baselines3")
     out = tmp_path / "out"
     runs = ppo_run(tmp_path)
     argv = ["--runs", str(runs), "--champion", str(champion_run), "--out", str(out), "--steps", "50"]
@@ -97,7 +99,7 @@ def test_rl_figures_refuses_bad_input_in_one_line_before_work(champion_run, tmp_
 
 
 def test_rl_ppo_refuses_to_overwrite_a_trained_model(tmp_path, capsys):
-    rl_ppo = load_example("rl_ppo")
+    rl_ppo = load_example("rl_ppo", needs="stable_baselines3")
     out = tmp_path / "run"
     out.mkdir()
     (out / "model.zip").write_bytes(b"PK weights of an hour of training")
@@ -130,14 +132,6 @@ def test_a_folder_given_as_the_experiment_is_a_folder_not_an_unknown_preset(tmp_
     assert "myrun: is a folder; allowed: a TOML experiment file" in err and "unknown preset" not in err
 
 
-def load_script(name: str):
-    """An example script as a module (no optional dependency needed)."""
-    spec = importlib.util.spec_from_file_location(f"script_{name}", ROOT / "examples" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 @pytest.mark.parametrize("case", ["steps-negative", "frame-every-0", "out-foreign-gif", "png-foreign"])
 def test_random_episode_refuses_bad_input_in_one_line_and_keeps_files(tmp_path, capsys, case):
     notes = tmp_path / "notes.gif"
@@ -151,16 +145,29 @@ def test_random_episode_refuses_bad_input_in_one_line_and_keeps_files(tmp_path, 
         "out-foreign-gif": (["--steps", "5", "--out", str(notes)], f"--out {notes}: exists and is not a .gif"),
         "png-foreign": (["--steps", "5", *out, "--png", str(picture)], f"--png {picture}: exists and is not a .png"),
     }[case]
-    assert call(load_script("random_episode").main, args) == 2
+    assert call(load_example("random_episode").main, args) == 2
     assert needle in one_error_line(capsys)
     assert notes.read_text() == "my notes" and picture.read_text() == "not a png"
     assert not (tmp_path / "new.gif").exists()
 
 
-def test_render_gallery_refuses_a_file_as_its_folder(champion_run, tmp_path, capsys):
+@pytest.mark.parametrize("case", ["out-is-a-file", "step-past-the-end", "pictures-exist", "champion-missing"])
+def test_render_gallery_refuses_bad_input_in_one_line_and_keeps_files(champion_run, tmp_path, capsys, case):
     a_file = tmp_path / "gallery"
     a_file.write_text("mine")
-    main = load_script("render_gallery").main
-    assert main([str(champion_run / "champion.json"), "--out", str(a_file), "--steps", "20", "--step", "10"]) == 2
-    assert f"--out {a_file}: is a file" in one_error_line(capsys)
-    assert a_file.read_text() == "mine"
+    earlier = tmp_path / "earlier"
+    earlier.mkdir()
+    (earlier / "render-zone.png").write_text("my picture")
+    champion = str(champion_run / "champion.json")
+    short = ["--steps", "20", "--step", "10"]
+    args, needle = {
+        "out-is-a-file": ([champion, "--out", str(a_file), *short], f"--out {a_file}: is a file"),
+        "step-past-the-end": ([champion, "--out", str(tmp_path / "new"), "--steps", "20", "--step", "21"],
+                              "--step: 21 is outside the episode; allowed: 1..20"),
+        "pictures-exist": ([champion, "--out", str(earlier), *short], "render-zone.png exists"),
+        "champion-missing": ([str(tmp_path / "nope.json"), "--out", str(tmp_path / "new"), *short], "nope.json"),
+    }[case]
+    assert load_example("render_gallery").main(args) == 2
+    assert needle in one_error_line(capsys)
+    assert a_file.read_text() == "mine" and (earlier / "render-zone.png").read_text() == "my picture"
+    assert not (tmp_path / "new").exists()
