@@ -172,8 +172,8 @@ def record_curve(step: str) -> Callable[[argparse.Namespace], None]:
 
 
 # docs/evidence folder -> (label, colour, line style): version 4's 2 x 2 of Encog's truncation and
-# weights (seed 1), version 4 with the original's bearings, and version 3's second seed for
-# scale; drawn from the committed records
+# weights (seed 1), version 4 with the original's bearings, versions 6-10, version 10's world bred as
+# version 3 was, and version 3's second seed for scale; drawn from the committed records
 V4_CELLS = {
     "original-S1-five": ("version 3 (neither), seed 1", "C0", "-"),
     "original-S1-five-seed2": ("version 3 (neither), seed 2", "C0", "--"),
@@ -186,6 +186,7 @@ V4_CELLS = {
     "original-S1-v8": ("version 8 (version 7 + the original's Khepera curve)", "C7", "-"),
     "original-S1-v9": ("version 9 (version 8 + the original's wall distances)", "C8", "-"),
     "original-S1-v10": ("version 10 (version 9 + Encog's species bookkeeping)", "C9", "-"),
+    "original-S1-v10-neat-breeding": ("version 10's world, version 3's breeding", "C9", "--"),
 }
 
 
