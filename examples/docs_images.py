@@ -25,8 +25,8 @@ checks that the list and the pictures in docs/ are the same). The steps:
   and the other steps of ``RECORD_CURVES`` (docs/evidence/<folder>/stats.png): the curve of a run
   kept going across sessions, drawn from its committed record (stats.jsonl);
 * ``original-s1-v4-cells`` (docs/evidence/original-S1-v4/cells.png): best-ever ft of version 4's
-  2 x 2 (Encog's truncation, Encog's weights, both, neither) and of version 4 with the original's
-  bearings, from the committed records;
+  2 x 2 (Encog's truncation, Encog's weights, both, neither), of versions 5-10 and of version 10's
+  world bred as version 3 was, from the committed records;
 * ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
   docs/rl/README.md; needs ``--rl DIR`` (the runs) and the demo champion.
 
