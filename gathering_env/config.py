@@ -46,7 +46,7 @@ CHOICES: dict[str, tuple[str, ...]] = {
     "ground_friction": GROUND_FRICTIONS, "drive_model": DRIVE_MODELS, "schedule": SCHEDULES,
     "ir_response": ("linear", "gamma", "khepera"), "bottom_response": ("linear", "khepera"),
     "wall_distance": ("nearest", "original"), "block_sighting": ("cone", "rays"),
-    "colour_response": ("nearer", "farther"),
+    "colour_response": ("nearer", "farther"), "attached_steering": ("sharp", "original"),
 }
 INT_RANGES: dict[str, tuple[int, int]] = {
     "num_robots": (1, 1000), "max_cycles": (1, 10**9),
@@ -175,6 +175,13 @@ class WorldConfig:
     put with its front on the anchor point, facing the block square to the sticky side, and
     welded there; off, it is welded where it stands, at whatever angle (then the robots on one
     block push in different directions: a scripted team gathers 35-80 % less)."""
+    attached_steering: str = "sharp"
+    """How a robot welded to a block steers towards the zone centre (it ignores its controller
+    while welded), from its heading error e, folded to [-pi/2, pi/2] by driving backwards (pulling
+    the block) when the centre lies behind it. The outer wheel runs at full power. 'sharp': the
+    inner one at (1 - t) / (1 + t) of it, t = min(4 |e| / pi, 1), so stopped from 45 degrees off;
+    'original': the 2018 code's ``Heuristic``, the inner one at 1 - 2 |e| / pi, stopped only at
+    90 degrees (``gathering_env.reference.heuristics.attached_wheels``)."""
     collision_avoidance: bool = False
     """Turn away from robots/walls just ahead, overriding the controller (original option, off)."""
     collision_avoidance_distance: float = 0.3

@@ -104,3 +104,37 @@ def test_a_full_block_refuses_more_robots(block_type):
     north(sim, need, gap=0.05, dx=0.0)         # one more robot at the full block's sticky side
     assert step(sim)[need] == -1
     assert (sim.world.anchor_owner[0, :need] >= 0).all()
+
+
+# Heading error e (the zone centre's bearing from the robot's heading) -> (left, right) wheels, worked
+# by hand: 'original' from the 2018 code's Heuristic.wheelDriveForTargetAngle quadrant by quadrant
+# (outer wheel +-1, inner (pi/2 - |e|) / (pi/2) forwards, backwards from +90 degrees, forwards at
+# -90), 'sharp' from t = clip(4 e' / pi) and (d - t, d + t) scaled to a largest wheel of 1.
+STEERING = [
+    (math.pi / 6, (2 / 3, 1.0), (0.2, 1.0)),                 # ahead, to the left
+    (-math.pi / 3, (1.0, 1 / 3), (1.0, 0.0)),                # ahead, to the right
+    (2 * math.pi / 3, (-1 / 3, -1.0), (0.0, -1.0)),          # behind, to the left: backwards
+    (-5 * math.pi / 6, (-1.0, -2 / 3), (-1.0, -0.2)),        # behind, to the right
+    (math.pi / 2, (0.0, -1.0), (0.0, 1.0)),                  # +90 degrees: the original reverses
+    (-math.pi / 2, (1.0, 0.0), (1.0, 0.0)),                  # -90 degrees: both go forwards
+    (0.0, (1.0, 1.0), (1.0, 1.0)),
+]
+
+
+@pytest.mark.parametrize("steering", ["original", "sharp"])
+@pytest.mark.parametrize("error, original, sharp", STEERING)
+def test_attached_steering_by_hand(steering, error, original, sharp):
+    """A welded robot's wheels (``WorldConfig.attached_steering``) at hand-picked heading errors
+    (the numpy reference; tests/test_kernels.py holds the compiled kernel to it over episodes)."""
+    from gathering_env.reference.heuristics import attached_wheels
+
+    cfg = WorldConfig.from_kwargs(environment=None, block_counts=(1, 0, 0), num_robots=1,
+                                  attached_steering=steering)
+    sim = GatheringSimulation(cfg)
+    sim.reset(seed=1)
+    cx, cy = cfg.zone_centre
+    # 10 units north of the zone centre, its bearing is -pi/2; heading -pi/2 - e makes the error e
+    sim.world.place_robot(0, cx, cy + 10.0, -math.pi / 2 - error)
+    want = original if steering == "original" else sharp
+    got = attached_wheels(sim.world, np.array([0]))[0]
+    np.testing.assert_allclose(got, want, atol=1e-12)

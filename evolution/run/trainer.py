@@ -103,6 +103,9 @@ def protocol_notes(exp: Experiment) -> list[str]:
     if exp.environment.get("wall_distance") == "original":
         notes.append(f"{exp.name}: the original's wall distances (wall_distance = original): a wall is read at the "
                      "distance the 2018 line formulas give, not its nearest point (gathering_env.reference.sensing)")
+    if exp.environment.get("attached_steering") == "original":
+        notes.append(f"{exp.name}: the original's steering of a welded robot (attached_steering = original): its "
+                     "inner wheel slows to a stop at 90 degrees off the zone centre, not 45 (gathering_env.reference.heuristics)")
     if exp.species_bookkeeping == "encog" and not exp.multi_objective:
         notes.append(f"{exp.name}: Encog's species books (species_bookkeeping = encog): the best genome's species "
                      "pointer names the best species, which outlives its leader; speciation after scoring; generation "

@@ -21,6 +21,7 @@ from ..drive import (
 from .tables import (
     F_AVOIDANCE,
     F_FORCE_DRIVE,
+    F_STEER_ORIGINAL,
     P_ARENA_H,
     P_ARENA_W,
     P_AVOID_DIST,
@@ -91,6 +92,7 @@ def drive(wheels, robot_pos, robot_angle, robot_attached, robot_rows, control_ro
     h = dt / params[P_SUBSTEPS]
     keep = params[P_KEEP]
     avoidance = flags[F_AVOIDANCE] != 0
+    steer_original = flags[F_STEER_ORIGINAL] != 0
     reach = r + params[P_AVOID_DIST]
     cx, cy = params[P_ZONE_CX], params[P_ZONE_CY]
     left = np.empty(n)
@@ -132,6 +134,18 @@ def drive(wheels, robot_pos, robot_angle, robot_attached, robot_rows, control_ro
             bearing = math.atan2(cy - robot_pos[w, i, 1], cx - robot_pos[w, i, 0])
             error = _wrap(bearing - robot_angle[w, i])
             direction = 1.0
+            if steer_original:
+                if error >= 0.5 * math.pi or error < -0.5 * math.pi:
+                    direction = -1.0
+                    error = _wrap(error - math.pi)
+                inner = direction * (1.0 - abs(error) / (0.5 * math.pi))
+                if error * direction >= 0.0:
+                    left[i] = inner
+                    right[i] = direction
+                else:
+                    left[i] = direction
+                    right[i] = inner
+                continue
             if abs(error) > 0.5 * math.pi:
                 direction = -1.0
                 error = _wrap(error - math.pi)

@@ -20,7 +20,7 @@ T_TYPE, T_BEARING, T_OFFSET, T_RANGE, T_COS_HALF, T_SIN_HALF, T_INV_RANGE = rang
  P_MAX_CYCLES, P_BOX_OFFSET, P_DEAD_BAND, P_MASS, P_MOMENT, P_SUBSTEPS, P_KEEP, P_SPIN_LIMIT) = range(26)
 # Entries of the integer flag vector.
 (F_IR_GAMMA, F_AVOIDANCE, F_PICKUP, F_FORCE_DRIVE, F_COLOUR_FARTHER, F_BLOCK_RAYS, F_IR_KHEPERA,
- F_BOTTOM_KHEPERA, F_WALL_ORIGINAL) = range(9)
+ F_BOTTOM_KHEPERA, F_WALL_ORIGINAL, F_STEER_ORIGINAL) = range(10)
 # Event kinds reported by ``settle`` (rows of the int event table: kind, world, robot, block, slot).
 EV_ATTACH, EV_RELEASE = 1, 2
 
@@ -51,5 +51,6 @@ def world_params(config) -> tuple[np.ndarray, np.ndarray]:
     flags = np.array([config.ir_response == "gamma", config.collision_avoidance, config.pickup_heuristic,
                       config.drive_model == "force", config.colour_response == "farther",
                       config.block_sighting == "rays", config.ir_response == "khepera",
-                      config.bottom_response == "khepera", config.wall_distance == "original"], dtype=np.int64)
+                      config.bottom_response == "khepera", config.wall_distance == "original",
+                      config.attached_steering == "original"], dtype=np.int64)
     return params, flags

@@ -6,8 +6,9 @@
   free anchor attaches to it (``GatheringWorld.try_attach``).
 * **Attached drive**: an attached robot ignores its controller and drives at full power
   towards the gathering zone's centre, forwards when the centre lies ahead of it and
-  backwards (pulling its block) when it lies behind, steering proportionally to the
-  heading error.
+  backwards (pulling its block) when it lies behind, its inner wheel slowed with the heading
+  error (``WorldConfig.attached_steering``: stopped from 45 degrees off, or from 90 as the
+  original's ``Heuristic``).
 * **Collision avoidance** (optional, off by default): a free robot with another robot or
   a wall closer than ``collision_avoidance_distance`` ahead of its front turns on the spot,
   away from the obstacle, instead of following its controller.
@@ -69,7 +70,8 @@ def pickup_candidates(world: GatheringWorld, gathered: np.ndarray) -> list[tuple
 
 
 def attached_wheels(world: GatheringWorld, robots: np.ndarray) -> np.ndarray:
-    """(len(robots), 2) full-power wheel commands steering towards the zone centre."""
+    """(len(robots), 2) full-power wheel commands steering towards the zone centre
+    (``WorldConfig.attached_steering``)."""
     cfg = world.config
     cx, cy = cfg.zone_centre
     pos = world.robot_pos[robots]
@@ -77,6 +79,15 @@ def attached_wheels(world: GatheringWorld, robots: np.ndarray) -> np.ndarray:
     # from it in the last bit: both kernels must steer identically.
     bearing = np.array([math.atan2(cy - y, cx - x) for x, y in pos.tolist()])
     error = _wrap(bearing - world.robot_angle[robots])
+    if cfg.attached_steering == "original":
+        # Heuristic.wheelDriveForTargetAngle's quadrants: backwards from +90 degrees on, forwards
+        # at -90; the outer wheel at full power, the inner one slowed linearly to 0 at 90 degrees.
+        backwards = (error >= 0.5 * math.pi) | (error < -0.5 * math.pi)
+        direction = np.where(backwards, -1.0, 1.0)
+        error = np.where(backwards, _wrap(error - math.pi), error)
+        inner = direction * (1.0 - np.abs(error) / (0.5 * math.pi))
+        left_inner = error * direction >= 0.0
+        return np.stack([np.where(left_inner, inner, direction), np.where(left_inner, direction, inner)], axis=1)
     backwards = np.abs(error) > 0.5 * math.pi
     direction = np.where(backwards, -1.0, 1.0)
     error = np.where(backwards, _wrap(error - math.pi), error)
