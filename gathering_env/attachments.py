@@ -4,7 +4,8 @@ A block needing k robots has k anchor points spread evenly along each side. The 
 to grip a block fixes its *sticky side*; later robots may only take that side's free anchors.
 A grip is a pymunk ``PivotJoint`` and ``GearJoint`` between robot and block (the weld), made
 where the robot stands or, with ``weld_seat`` (the default, as in the original), after seating
-the robot's front on the anchor, square to the side. When to try a grip and when to let go
+the robot's front on the anchor, square to the side. With ``weld_spin = "free"`` a welded robot's
+ground-friction torque lets go until it is released. When to try a grip and when to let go
 is the simulation's business (``gathering_env.simulation``); ``GatheringWorld`` keeps the
 arrays (``robot_attached``, ``block_sticky_side``, ``anchor_owner``) and the bodies.
 """
@@ -15,6 +16,8 @@ import math
 
 import numpy as np
 import pymunk
+
+from .drive import control_limits
 
 # Block sides in the block frame: outward normal and tangent of side 0..3 (E, N, W, S).
 _SIDE_NORMALS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
@@ -91,12 +94,16 @@ class Attachments:
         gear.collide_bodies = False
         self.space.add(pivot, gear)
         self._welds[robot] = (pivot, gear)
+        if cfg.weld_spin == "free":  # the robot's friction torque lets go while it is welded
+            self.control_gears[robot].max_force = 0.0
         if cfg.weld_seat:
             self.read_state()
 
     def unweld(self, robot: int) -> None:
         """Remove the pymunk weld of ``robot`` (the arrays are the caller's business)."""
         self.space.remove(*self._welds.pop(int(robot)))
+        if self.config.weld_spin == "free":
+            self.control_gears[int(robot)].max_force = control_limits(self.config)[1]
 
     def detach_block(self, block: int) -> None:
         """Release every robot welded to ``block`` and clear its sticky side."""

@@ -47,6 +47,7 @@ CHOICES: dict[str, tuple[str, ...]] = {
     "ir_response": ("linear", "gamma", "khepera"), "bottom_response": ("linear", "khepera"),
     "wall_distance": ("nearest", "original"), "block_sighting": ("cone", "rays"),
     "colour_response": ("nearer", "farther"), "attached_steering": ("sharp", "original"),
+    "weld_spin": ("held", "free"),
 }
 INT_RANGES: dict[str, tuple[int, int]] = {
     "num_robots": (1, 1000), "max_cycles": (1, 10**9),
@@ -182,6 +183,15 @@ class WorldConfig:
     inner one at (1 - t) / (1 + t) of it, t = min(4 |e| / pi, 1), so stopped from 45 degrees off;
     'original': the 2018 code's ``Heuristic``, the inner one at 1 - 2 |e| / pi, stopped only at
     90 degrees (``gathering_env.reference.heuristics.attached_wheels``)."""
+    weld_spin: str = "held"
+    """Under the force drive, whether a welded robot's ground friction holds its spin. 'held':
+    as when it is free (the robot and its block turn only if the steering's torque beats both
+    their friction torques, which it never does at one robot per block). 'free': the robot's
+    friction torque is released while it is welded, so the pair turns against the block's
+    friction torque, its sliding friction and the robot's traction impulse. Measured on the
+    original's own classes, a welded robot's friction torque has no effect on its pair (any
+    coefficient gives the same path) and the pair arcs its block into the zone from up to ~66
+    degrees off (docs/fidelity.md, "gripped-block steering"); 'free' models that."""
     collision_avoidance: bool = False
     """Turn away from robots/walls just ahead, overriding the controller (original option, off)."""
     collision_avoidance_distance: float = 0.3
@@ -361,6 +371,9 @@ def _validate(config: WorldConfig) -> None:
     if config.drive_model == "force" and config.drive_dead_band != 0.0:
         raise ValueError(f"drive_dead_band={config.drive_dead_band!r} with drive_model='force': "
                          "the force drive has its own dead band; allowed: 0")
+    if config.weld_spin == "free" and config.drive_model != "force":
+        raise ValueError(f"weld_spin='free' with drive_model={config.drive_model!r}: it releases the force drive's "
+                         "friction torque; allowed: drive_model='force', or weld_spin='held'")
     if config.layout_seed is not None:
         _check_int("layout_seed", config.layout_seed, 0, 2 ** 63 - 1)
     if config.schedule == "shuffled" and config.drive_model != "force":

@@ -134,6 +134,7 @@ class GatheringWorld(Attachments):
         apply_restitution(space, {"robot": robot_shapes, "block": block_shapes, "wall": walls}, cfg)
 
         self.control_bodies: list[pymunk.Body] = []
+        self.control_gears: list[pymunk.GearJoint] = []  # under the force drive: the robot's friction torque
         max_force, max_torque = control_limits(cfg)
         for body in self.robot_bodies:
             control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
@@ -146,6 +147,7 @@ class GatheringWorld(Attachments):
             gear.max_force = max_torque
             space.add(control, pivot, gear)
             self.control_bodies.append(control)
+            self.control_gears.append(gear)
 
         self._index_bodies()
         n, b = cfg.num_robots, len(types)

@@ -190,9 +190,12 @@ def _episode(kernel: str, steps: int, morphology: Morphology, seed: int, **world
     dict(SMALL, colour_response="farther", block_sighting="rays", ir_response="khepera", bottom_response="khepera",
          wall_distance="original"),
     dict(SMALL, pickup_box="centre", pickup_box_width=0.4, pickup_box_depth=0.4, attached_steering="original"),
+    dict(SMALL, ground_friction="mass", robot_restitution=1.0, block_restitution=0.4, wall_restitution=1.0,
+         drive_model="force", damping=0.1, pickup_box="centre", pickup_box_width=0.4, pickup_box_depth=0.4,
+         attached_steering="original", weld_spin="free"),
 ], ids=["small", "avoidance", "weld-in-place", "gamma-substeps", "env3", "centre-box", "original-box",
         "original-physics", "force-drive", "force-drive-substeps", "force-drive-shuffled", "original-sensing",
-        "original-steering"])
+        "original-steering", "weld-spin-free"])
 def test_whole_episodes_are_identical_on_both_kernels(world):
     steps = 1000 if world.get("drive_model") == "force" else 400   # slower robots: reach the zone
     attached = gathered = shared = False

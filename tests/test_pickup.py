@@ -138,3 +138,55 @@ def test_attached_steering_by_hand(steering, error, original, sharp):
     want = original if steering == "original" else sharp
     got = attached_wheels(sim.world, np.array([0]))[0]
     np.testing.assert_allclose(got, want, atol=1e-12)
+
+
+ORIGINAL_ROBOT = dict(environment=None, num_robots=1, block_counts=(1, 0, 0), zone_depth=4.0, ground_friction="mass",
+                      robot_restitution=1.0, block_restitution=0.4, wall_restitution=1.0, drive_model="force",
+                      damping=0.1, attached_steering="original")
+
+
+def carry(kernel: str, weld_spin: str, block: tuple[float, float] = (5.0, 10.0), steps: int = 1500):
+    """One robot welded to the west side of a small block, steered by the heuristic: (steps until
+    the block lies in the zone or the limit, block x, block y, robot heading at the end)."""
+    cfg = WorldConfig.from_kwargs(**ORIGINAL_ROBOT, kernel=kernel, weld_spin=weld_spin, max_cycles=steps + 10)
+    sim = GatheringSimulation(cfg)
+    sim.reset(seed=1)
+    w = sim.world
+    w.place_block(0, *block, 0.0)
+    w.place_robot(0, block[0] - w.block_half[0] - cfg.robot_radius - 0.02, block[1], 0.0)
+    assert w.try_attach(0, 0)
+    taken = 0
+    while taken < steps and sim.task_performance() == 0:
+        sim.step(np.zeros((1, 2)))
+        taken += 1
+    return taken, float(w.block_pos[0, 0]), float(w.block_pos[0, 1]), float(w.robot_angle[0])
+
+
+@pytest.mark.parametrize("kernel", ["numpy", "compiled"])
+def test_a_welded_pair_turns_only_with_weld_spin_free(kernel):
+    """The zone centre lies 27.5 degrees to the right of a welded robot's heading. The original's
+    own classes (measured with its RobotObject, ResourceObject and Box2D world, fixed order)
+    arc the block into the zone in 943 steps, whatever the robot's friction torque. Held by that
+    torque, ours drives straight on east, never turning; with weld_spin = "free" it arcs right and
+    gathers the block (in 766 steps), the same on both kernels."""
+    steps, x, y, heading = carry(kernel, "held")
+    assert steps == 1500 and y == pytest.approx(10.0, abs=1e-6) and abs(heading) < 1e-6 and x > 15
+    steps, x, y, heading = carry(kernel, "free")
+    assert steps < 1000 and y < 4.0 and heading < -0.5
+    assert (steps, x, y) == carry("numpy", "free")[:3]
+
+
+def test_weld_spin_free_lets_go_of_the_friction_torque_only_while_welded():
+    from gathering_env.drive import control_limits
+
+    cfg = WorldConfig.from_kwargs(**ORIGINAL_ROBOT, weld_spin="free")
+    sim = GatheringSimulation(cfg)
+    sim.reset(seed=1)
+    w = sim.world
+    torque = control_limits(cfg)[1]
+    assert torque > 0 and w.control_gears[0].max_force == torque
+    w.place_block(0, 5.0, 10.0, 0.0)
+    w.place_robot(0, 5.0 - w.block_half[0] - cfg.robot_radius - 0.02, 10.0, 0.0)
+    assert w.try_attach(0, 0) and w.control_gears[0].max_force == 0.0
+    w.detach_block(0)
+    assert w.robot_attached[0] == -1 and w.control_gears[0].max_force == torque

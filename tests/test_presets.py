@@ -42,7 +42,7 @@ def test_list_prints_every_preset_with_its_first_comment_sentence(capsys):
     assert set(listed) == PAPER_PRESETS | original | {"hyperneat_m.neat.cfg", "neat_m.neat.cfg"}
     # one header line per set: the paper's presets, the original protocol's, the neat configs
     assert [line.split(":")[0] for line in lines if line.startswith("#")] == [
-        '# protocol "paper"', '# protocol "original" (version 10; protocol_version picks another)', "# neat-python configs"]
+        '# protocol "paper"', '# protocol "original" (version 11; protocol_version picks another)', "# neat-python configs"]
     # hand-read from the files' opening comments
     assert listed["S1"] == "Experiment S1 of the paper: single objective (task performance), environment 1."
     assert listed["M3"].startswith("Experiment M3 of the paper: multi-objective")

@@ -17,7 +17,7 @@ from evolution.run import backends
 from evolution.run.evaluate import Evaluation, episode_seeds, trial_seed
 from evolution.run.experiment import ExperimentError, experiment_from_run, load_experiment
 from evolution.run.presets import preset_text, resolve_preset
-from evolution.run.protocol import ORIGINAL, protocol_values, versions
+from evolution.run.protocol import ORIGINAL, protocol_values
 from evolution.run.recorder import convergence_target
 from evolution.run.stats import read_stats, without_work
 from gathering_env import Morphology, SensorSpec, morphological_complexity
@@ -176,7 +176,10 @@ def test_the_versions_of_the_original_bundle():
     v10 = protocol_values("original", 10)
     assert v10["environment"] == v9["environment"] and v10["substrate"] == v9["substrate"]
     assert v10["experiment"] == v9["experiment"] | {"species_bookkeeping": "encog"}
-    assert protocol_values("original") == v10 and ORIGINAL["environment"] == v10["environment"]
+    v11 = protocol_values("original", 11)
+    assert v11["experiment"] == v10["experiment"] and v11["substrate"] == v10["substrate"]
+    assert v11["environment"] == v10["environment"] | {"attached_steering": "original", "weld_spin": "free"}
+    assert protocol_values("original") == v11 and ORIGINAL["environment"] == v11["environment"]
     # "paper" names the defaults of every key any version sets
     paper = protocol_values("paper")["environment"]
     assert (paper["drive_model"], paper["damping"], paper["schedule"], paper["drive_dead_band"],
@@ -188,9 +191,11 @@ def test_the_versions_of_the_original_bundle():
     assert protocol_values("paper")["environment"]["block_sighting"] == "cone"
     assert protocol_values("paper")["environment"]["bottom_response"] == "linear"
     assert protocol_values("paper")["environment"]["wall_distance"] == "nearest"
+    assert (protocol_values("paper")["environment"]["attached_steering"],
+            protocol_values("paper")["environment"]["weld_spin"]) == ("sharp", "held")
 
 
-@pytest.mark.parametrize("version", [1, 2, 3, 4, 5, 6, 7, 8, 9, 10])
+@pytest.mark.parametrize("version", [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11])
 def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path, version):
     exp = load_experiment(experiment(tmp_path, body=f'protocol = "original"\nprotocol_version = {version}'))
     saved = exp.to_dict()
@@ -208,6 +213,8 @@ def test_a_run_saved_before_versions_keeps_the_bundle_it_was_run_under(tmp_path,
         (("khepera", "khepera") if version >= 8 else ("gamma", "linear"))
     assert again.world_config().wall_distance == ("original" if version >= 9 else "nearest")
     assert again.species_bookkeeping == exp.species_bookkeeping == ("encog" if version >= 10 else "membership")
+    assert (again.world_config().attached_steering, again.world_config().weld_spin) == \
+        (("original", "free") if version >= 11 else ("sharp", "held"))
 
 
 @pytest.mark.parametrize("folder, version", [("original-S1-2018", 1), ("original-S1-elite02", 1),
@@ -233,8 +240,8 @@ def test_the_five_schedule_record_is_the_s1_original_preset():
 
 
 @pytest.mark.parametrize("body, needle", [
-    ('protocol = "original"\nprotocol_version = 11', "[experiment] protocol_version=11; allowed for protocol = "
-                                                     "'original': [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]"),
+    ('protocol = "original"\nprotocol_version = 12', "[experiment] protocol_version=12; allowed for protocol = "
+                                                     "'original': [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11]"),
     ('protocol = "original"\nprotocol_version = true', "protocol_version=True; allowed for protocol = 'original'"),
     ('protocol = "paper"\nprotocol_version = 2', "[experiment] protocol_version=2; allowed for protocol = 'paper': [1]"),
     ("protocol_version = 2", "[experiment] protocol_version=2 without a protocol; allowed: with protocol"),
@@ -378,12 +385,13 @@ def test_a_run_under_the_original_protocol_resumes_to_the_same_statistics(tmp_pa
     assert len(whole) == 4 and part == whole
     saved = json.loads((tmp_path / "part" / "experiment.json").read_text())
     assert saved["protocol"] == "original" and saved["environment"]["zone_depth"] == 4.0
-    assert saved["protocol_version"] == 10 and saved["truncation"] == saved["weights"] == "encog"
+    assert saved["protocol_version"] == 11 and saved["truncation"] == saved["weights"] == "encog"
     assert saved["species_bookkeeping"] == "encog"
     assert saved["environment"]["schedule"] == "shuffled" and saved["substrate"]["bearings"] == "atan"
     assert saved["environment"]["colour_response"] == "farther" and saved["environment"]["block_sighting"] == "rays"
     assert saved["environment"]["ir_response"] == saved["environment"]["bottom_response"] == "khepera"
     assert saved["environment"]["wall_distance"] == "original"
+    assert (saved["environment"]["attached_steering"], saved["environment"]["weld_spin"]) == ("original", "free")
     shutil.rmtree(tmp_path / "part")
 
 
@@ -925,9 +933,37 @@ def test_each_sensing_version_says_so_and_its_run_is_the_preset(version, folder,
     assert mine["environment"] == theirs["environment"] | added
 
 
-def test_the_newest_bundle_is_version_10():
+def test_the_newest_bundle_is_version_11():
     path, overrides = resolve_preset("S1-original")
-    assert load_experiment(path, overrides).protocol_version == 10
+    assert load_experiment(path, overrides).protocol_version == 11
+
+
+def test_the_welded_robot_version_says_so_and_its_run_is_the_preset():
+    """A run under version 11 says at its start that a welded robot steers and turns as the
+    original's did (either method); one under version 10 does not; the committed version-11 run
+    is the S1-original preset key for key and differs from the version-10 run by those two keys."""
+    from dataclasses import replace
+
+    from evolution.run.trainer import protocol_notes
+
+    path, overrides = resolve_preset("S1-original")
+    exp = load_experiment(path, overrides)
+    added = {"attached_steering": "original", "weld_spin": "free"}
+    assert {k: exp.environment[k] for k in added} == added
+    for key in added:
+        assert sum(f"{key} = {added[key]}" in n for n in protocol_notes(exp)) == 1
+        assert any(f"{key} = {added[key]}" in n for n in protocol_notes(replace(exp, method="neat-m")))
+    previous = load_experiment(path, {**(overrides or {}), "protocol_version": 10})
+    assert (previous.world_config().attached_steering, previous.world_config().weld_spin) == ("sharp", "held")
+    assert not any("attached_steering" in n or "weld_spin" in n for n in protocol_notes(previous))
+    drop = ("name", "source", "protocol", "protocol_version")
+    mine = {k: v for k, v in load_experiment(EVIDENCE / "original-S1-v11" / "experiment.toml").to_dict().items()
+            if k not in drop}
+    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
+    theirs = {k: v for k, v in load_experiment(EVIDENCE / "original-S1-v10" / "experiment.toml").to_dict().items()
+              if k not in drop}
+    assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
+    assert mine["environment"] == theirs["environment"] | added
 
 
 def test_the_bookkeeping_version_says_so_and_its_run_is_the_preset():
@@ -939,7 +975,7 @@ def test_the_bookkeeping_version_says_so_and_its_run_is_the_preset():
     from evolution.run.trainer import protocol_notes
 
     path, overrides = resolve_preset("S1-original")
-    exp = load_experiment(path, overrides)
+    exp = load_experiment(path, {**(overrides or {}), "protocol_version": 10})
     assert exp.species_bookkeeping == "encog"
     assert sum("species_bookkeeping = encog" in n for n in protocol_notes(exp)) == 1
     assert not any("species_bookkeeping" in n for n in protocol_notes(replace(exp, objectives=("task", "morphology"))))
@@ -989,20 +1025,3 @@ def test_a_paper_protocol_run_saved_before_the_bundle_grew_resumes_in_the_same_w
     assert again.environment == saved["environment"] and again.world_config() == exp.world_config()
     assert again.to_dict()["environment"] == saved["environment"]
 
-
-def test_the_original_steering_is_an_option_outside_the_bundle_and_a_run_says_so():
-    """``attached_steering = "original"`` is the 2018 Heuristic's steering (tests/test_pickup.py
-    works it by hand); no version of the bundle sets it (a welded pair does not turn here, see
-    evolution.run.protocol), and a run that sets it says so at its start, with either method."""
-    from dataclasses import replace
-
-    from evolution.run.trainer import protocol_notes
-
-    assert all("attached_steering" not in protocol_values("original", v)["environment"] for v in versions("original"))
-    path, overrides = resolve_preset("S1-original")
-    exp = load_experiment(path, overrides)
-    assert exp.world_config().attached_steering == "sharp"
-    assert not any("attached_steering" in n for n in protocol_notes(exp))
-    steered = replace(exp, environment={**exp.environment, "attached_steering": "original"})
-    assert sum("attached_steering = original" in n for n in protocol_notes(steered)) == 1
-    assert any("attached_steering = original" in n for n in protocol_notes(replace(steered, method="neat-m")))

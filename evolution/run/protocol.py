@@ -46,6 +46,11 @@ block_sighting``                                  along its axis and its two edg
 wall_distance``                                   the distance the 2018 formulas give
 ``[environment]               ``"threshold"``     ``"mass"``: kinetic Coulomb friction 0.1 m g
 ground_friction``                                 whatever the robots needed (docs/fidelity.md)
+``[environment]               ``"sharp"``         ``"original"`` (version 11): a robot welded to a
+attached_steering``                               block slows its inner wheel to 0 at 90 degrees
+                                                  off the zone centre, not at 45
+``[environment] weld_spin``   ``"held"``          ``"free"`` (version 11): a welded robot's
+                                                  friction torque lets go, so the pair can turn
 ``[environment] robot_,       0, 0, 0             1, 0.4, 1 (Box2D's: a contact takes the larger)
 block_, wall_restitution``
 ``[environment] drive_model,  ``"velocity"``, 0   ``"force"``, 0.1: the original robot (wheel
@@ -61,12 +66,6 @@ damping``                                         forces, traction impulse, its 
 
 (The time bonus 20, the 5 trials of 10 000 steps, the sensor-type bands' order and the weld that
 seats the robot are the paper's and the 2018 code's alike, so they are not in the bundle.)
-``[environment] attached_steering = "original"`` (the 2018 ``Heuristic``'s steering of a robot
-welded to a block: the inner wheel stopped only at 90 degrees off the zone centre, not 45) is an
-option the bundle leaves out for now: in the 2018 simulator a welded robot arcs its block into
-the zone from up to ~66 degrees off, in this one the pair does not turn under either steering
-and goes straight on (docs/fidelity.md, "gripped-block steering"), so the original's rule alone
-only drives the pair further off course.
 
 **Versions.** A bundle that is found to differ from the code it names is corrected in a new
 version, never in place, so that every run made under an earlier one still resumes and rebuilds
@@ -113,12 +112,20 @@ newest one whose keys it holds with the same values (``saved_version``). The ori
    "original"``): its sensors read a wall they see at the distance its line formulas give
    (``gathering_env.reference.sensing.original_wall_distance``), which mix the sensor's frame with
    the world's, where versions 1-8 read the wall's nearest point in the cone.
-10. (2026-12, the newest) adds Encog's species bookkeeping (``species_bookkeeping = "encog"``,
+10. (2026-12) adds Encog's species bookkeeping (``species_bookkeeping = "encog"``,
     single-objective runs): the best species is the one the best genome *points at* (a pointer
     set when a genome joins a species, inherited by mutants), which survives its leader's death;
     a population is speciated after it is scored (leaders change during the pass); generation
     0 is speciated at 0.99, nearly a species per genome, and the ratchet starts from its first
     genome. Versions 1-9 named species by membership (``evolution.reproduction.bookkeeping``).
+11. (2026-12, the newest) adds the 2018 code's welded robot: its steering (``attached_steering =
+    "original"``, its ``Heuristic``: outer wheel at full power, inner at 1 - 2|e|/pi for a heading
+    error e off the zone centre, stopped only at 90 degrees where versions 1-10 stopped it from
+    45) and a pair that turns (``weld_spin = "free"``: the robot's ground-friction torque lets go
+    while it is welded). Measured on the original's own classes, a robot welded to a small block
+    27.5 degrees off course arcs it into the zone in 943 steps whatever the robot's friction
+    torque; in versions 1-10 the pair never turned and drove straight on until it stalled 90
+    degrees off (``gathering_env.attachments``; docs/fidelity.md, "gripped-block steering").
 
 ``protocol = "paper"`` names the defaults (one version). A file that names a protocol and sets
 one of its keys to another value is refused (``ExperimentError`` naming the file and key);
@@ -168,6 +175,10 @@ ORIGINAL_WALLS = {"wall_distance": "original"}
 #: Encog's species bookkeeping (version 10; ``evolution.reproduction.bookkeeping``).
 ORIGINAL_BOOKS = {"species_bookkeeping": "encog"}
 
+#: The 2018 code's welded robot (version 11): its steering (``Heuristic``;
+#: ``gathering_env.reference.heuristics.attached_wheels``) and a pair that turns (``weld_spin``).
+ORIGINAL_WELDED = {"attached_steering": "original", "weld_spin": "free"}
+
 #: Protocol name -> version -> {section: {key: value}}; the "paper" values are the defaults of
 #: the dataclasses that own the keys (``Experiment``, ``WorldConfig``, ``Substrate``), filled in
 #: by ``protocol_values``.
@@ -204,6 +215,10 @@ BUNDLES: dict[str, dict[int, dict[str, dict[str, Any]]]] = {
              "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE, **ORIGINAL_COLOUR,
                              **ORIGINAL_SIGHTING, **ORIGINAL_KHEPERA, **ORIGINAL_WALLS},
              "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
+        11: {"experiment": {**_METHOD, **ORIGINAL_BREEDING, **ORIGINAL_BOOKS},
+             "environment": {**_SENSING, **_CONTACTS, **ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE, **ORIGINAL_COLOUR,
+                             **ORIGINAL_SIGHTING, **ORIGINAL_KHEPERA, **ORIGINAL_WALLS, **ORIGINAL_WELDED},
+             "substrate": {**_SUBSTRATE, **ORIGINAL_BEARINGS}},
     },
     "paper": {1: {}},
 }
@@ -223,6 +238,7 @@ DESCRIPTIONS = {
     "original": "the 2018 Java code that produced the published figures: one layout per run, ratchet on the best "
                 "genome, Encog's truncation and link weights, zone 20 x 4, pickup box at the robot's centre, 20 % decoding window, its "
                 "sensor bearings (all on the front half), its colour reading (rising with distance), block sighting (three rays), wall distances and Khepera curve (infrared, bottom), its eq. 2, Encog's species bookkeeping, its "
+                "welded robot (its steering, a pair that turns), its "
                 "physics (mass friction, bouncing contacts) and its robot on its shuffled schedule",
 }
 

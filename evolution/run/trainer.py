@@ -106,6 +106,9 @@ def protocol_notes(exp: Experiment) -> list[str]:
     if exp.environment.get("attached_steering") == "original":
         notes.append(f"{exp.name}: the original's steering of a welded robot (attached_steering = original): its "
                      "inner wheel slows to a stop at 90 degrees off the zone centre, not 45 (gathering_env.reference.heuristics)")
+    if exp.environment.get("weld_spin") == "free":
+        notes.append(f"{exp.name}: the original's welded pair (weld_spin = free): a welded robot's friction torque "
+                     "lets go, so robot and block turn together (gathering_env.attachments)")
     if exp.species_bookkeeping == "encog" and not exp.multi_objective:
         notes.append(f"{exp.name}: Encog's species books (species_bookkeeping = encog): the best genome's species "
                      "pointer names the best species, which outlives its leader; speciation after scoring; generation "
