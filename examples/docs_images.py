@@ -25,7 +25,7 @@ checks that the list and the pictures in docs/ are the same). The steps:
   and the other steps of ``RECORD_CURVES`` (docs/evidence/<folder>/stats.png): the curve of a run
   kept going across sessions, drawn from its committed record (stats.jsonl);
 * ``original-s1-v4-cells`` (docs/evidence/original-S1-v4/cells.png): best-ever ft of version 4's
-  2 x 2 (Encog's truncation, Encog's weights, both, neither), of versions 5-10 and of version 10's
+  2 x 2 (Encog's truncation, Encog's weights, both, neither), of versions 5-11 and of version 10's
   world bred as version 3 was, from the committed records;
 * ``rl`` (docs/rl/*.png): ``examples/rl_figures.py`` and the learning curves of the PPO runs of
   docs/rl/README.md; needs ``--rl DIR`` (the runs) and the demo champion.
@@ -172,7 +172,7 @@ def record_curve(step: str) -> Callable[[argparse.Namespace], None]:
 
 
 # docs/evidence folder -> (label, colour, line style): version 4's 2 x 2 of Encog's truncation and
-# weights (seed 1), version 4 with the original's bearings, versions 6-10, version 10's world bred as
+# weights (seed 1), version 4 with the original's bearings, versions 6-11, version 10's world bred as
 # version 3 was, and version 3's second seed for scale; drawn from the committed records
 V4_CELLS = {
     "original-S1-five": ("version 3 (neither), seed 1", "C0", "-"),
@@ -187,6 +187,7 @@ V4_CELLS = {
     "original-S1-v9": ("version 9 (version 8 + the original's wall distances)", "C8", "-"),
     "original-S1-v10": ("version 10 (version 9 + Encog's species bookkeeping)", "C9", "-"),
     "original-S1-v10-neat-breeding": ("version 10's world, version 3's breeding", "C9", "--"),
+    "original-S1-v11": ("version 11 (version 10 + the original's welded robot)", "k", "-"),
 }
 
 
@@ -210,7 +211,7 @@ def make_v4_cells(args: argparse.Namespace) -> None:
     ax.axhline(110, color="grey", lw=0.8, ls=":", label="convergence (110)")
     ax.set_xlabel("generation")
     ax.set_ylabel("best-ever ft (mean of 5 schedules)")
-    ax.set_title("S1-original: version 4's options one at a time, versions 5-10 (seed 1)")
+    ax.set_title("S1-original: version 4's options one at a time, versions 5-11 (seed 1)")
     ax.legend(loc="lower right", fontsize=8)
     fig.tight_layout()
     fig.savefig(DOCS / "evidence" / "original-S1-v4" / "cells.png", dpi=110)
