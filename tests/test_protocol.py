@@ -145,6 +145,17 @@ def test_dumped_protocol_preset_loads_like_the_preset(tmp_path, capsys):
 EVIDENCE = Path(__file__).resolve().parents[1] / "docs" / "evidence"
 
 
+def settings(exp) -> dict:
+    """What an experiment runs, without its name, source file and protocol label (a preset
+    names the protocol, its record sets every key of it on its own)."""
+    return {k: v for k, v in exp.to_dict().items() if k not in ("name", "source", "protocol", "protocol_version")}
+
+
+def record_settings(folder: str) -> dict:
+    """``settings`` of a committed evidence run's experiment file."""
+    return settings(load_experiment(EVIDENCE / folder / "experiment.toml"))
+
+
 def test_the_versions_of_the_original_bundle():
     v1, v2, v3 = (protocol_values("original", v)["environment"] for v in (1, 2, 3))
     assert v1 == {"zone_depth": 4.0, "pickup_box": "centre", "pickup_box_width": 0.2, "pickup_box_depth": 0.1,
@@ -234,8 +245,7 @@ def test_the_five_schedule_record_is_the_s1_original_preset():
     preset = load_experiment(path, {**(overrides or {}), "protocol_version": 3})
     assert (record.protocol, preset.protocol_version, record.truncation, record.weights) == (None, 3, "neat", "neat")
     assert (load_experiment(path, overrides).truncation, load_experiment(path, overrides).weights) == ("encog", "encog")
-    mine = {k: v for k, v in record.to_dict().items() if k not in ("name", "source", "protocol", "protocol_version")}
-    theirs = {k: v for k, v in preset.to_dict().items() if k not in ("name", "source", "protocol", "protocol_version")}
+    mine, theirs = settings(record), settings(preset)
     assert mine == theirs
 
 
@@ -893,11 +903,10 @@ def test_the_bearings_note_and_the_bearings_run_are_version_5():
                                                                                        "protocol_version": 4})))
     assert not any("bearings = atan" in n for n in protocol_notes(replace(exp, method="neat-m")))
     record = load_experiment(EVIDENCE / "original-S1-v4-atan-bearings" / "experiment.toml")
-    drop = ("name", "source", "protocol", "protocol_version")
-    mine = {k: v for k, v in record.to_dict().items() if k not in drop}
-    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
+    mine = settings(record)
+    assert mine == settings(exp)
     v4 = experiment_from_run(json.loads((EVIDENCE / "original-S1-v4" / "experiment.json").read_text()), "v4")
-    theirs = {k: v for k, v in v4.to_dict().items() if k not in drop}
+    theirs = settings(v4)
     assert {k for k in mine if mine[k] != theirs[k]} == {"substrate"}
     assert mine["substrate"] == theirs["substrate"] | {"bearings": "atan"}
 
@@ -925,10 +934,9 @@ def test_each_sensing_version_says_so_and_its_run_is_the_preset(version, folder,
     assert any(note in n for n in protocol_notes(replace(exp, method="neat-m")))
     previous = load_experiment(path, {**(overrides or {}), "protocol_version": version - 1})
     assert not any(note in n for n in protocol_notes(previous))
-    drop = ("name", "source", "protocol", "protocol_version")
-    mine = {k: v for k, v in load_experiment(EVIDENCE / folder / "experiment.toml").to_dict().items() if k not in drop}
-    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
-    theirs = {k: v for k, v in load_experiment(EVIDENCE / before / "experiment.toml").to_dict().items() if k not in drop}
+    mine = record_settings(folder)
+    assert mine == settings(exp)
+    theirs = record_settings(before)
     assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
     assert mine["environment"] == theirs["environment"] | added
 
@@ -956,12 +964,9 @@ def test_the_welded_robot_version_says_so_and_its_run_is_the_preset():
     previous = load_experiment(path, {**(overrides or {}), "protocol_version": 10})
     assert (previous.world_config().attached_steering, previous.world_config().weld_spin) == ("sharp", "held")
     assert not any("attached_steering" in n or "weld_spin" in n for n in protocol_notes(previous))
-    drop = ("name", "source", "protocol", "protocol_version")
-    mine = {k: v for k, v in load_experiment(EVIDENCE / "original-S1-v11" / "experiment.toml").to_dict().items()
-            if k not in drop}
-    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
-    theirs = {k: v for k, v in load_experiment(EVIDENCE / "original-S1-v10" / "experiment.toml").to_dict().items()
-              if k not in drop}
+    mine = record_settings("original-S1-v11")
+    assert mine == settings(exp)
+    theirs = record_settings("original-S1-v10")
     assert {k for k in mine if mine[k] != theirs[k]} == {"environment"}
     assert mine["environment"] == theirs["environment"] | added
 
@@ -982,12 +987,9 @@ def test_the_bookkeeping_version_says_so_and_its_run_is_the_preset():
     previous = load_experiment(path, {**(overrides or {}), "protocol_version": 9})
     assert previous.species_bookkeeping == "membership"
     assert not any("species_bookkeeping" in n for n in protocol_notes(previous))
-    drop = ("name", "source", "protocol", "protocol_version")
-    mine = {k: v for k, v in load_experiment(EVIDENCE / "original-S1-v10" / "experiment.toml").to_dict().items()
-            if k not in drop}
-    assert mine == {k: v for k, v in exp.to_dict().items() if k not in drop}
-    theirs = {k: v for k, v in load_experiment(EVIDENCE / "original-S1-v9" / "experiment.toml").to_dict().items()
-              if k not in drop}
+    mine = record_settings("original-S1-v10")
+    assert mine == settings(exp)
+    theirs = record_settings("original-S1-v9")
     assert {k for k in mine if mine[k] != theirs[k]} == {"species_bookkeeping"}
 
 

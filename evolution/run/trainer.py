@@ -59,6 +59,22 @@ class RunResult:
     """Genomes this invocation had evaluated (the carried ones not counted)."""
 
 
+#: World options of the original protocol that a run names at its start: (key, value) -> (what
+#: of the original's it is, what it does and where).
+WORLD_NOTES = {
+    ("colour_response", "farther"): ("colour reading", "a block reads 0.5 + d/2R, a wall d/2R, rising with "
+                                     "distance d (gathering_env.reference.sensing)"),
+    ("block_sighting", "rays"): ("block sighting", "a sensor sees a block only along its axis and its two cone "
+                                 "edges (gathering_env.reference.sensing)"),
+    ("wall_distance", "original"): ("wall distances", "a wall is read at the distance the 2018 line formulas "
+                                    "give, not its nearest point (gathering_env.reference.sensing)"),
+    ("attached_steering", "original"): ("steering of a welded robot", "its inner wheel slows to a stop at 90 "
+                                        "degrees off the zone centre, not 45 (gathering_env.reference.heuristics)"),
+    ("weld_spin", "free"): ("welded pair", "a welded robot's friction torque lets go, so robot and block turn "
+                            "together (gathering_env.attachments)"),
+}
+
+
 def protocol_notes(exp: Experiment) -> list[str]:
     """What a run does differently from the paper's defaults, one line each (printed at its start)."""
     notes = []
@@ -90,25 +106,13 @@ def protocol_notes(exp: Experiment) -> list[str]:
     if exp.method == "hyperneat-m" and exp.substrate.get("bearings") == "atan":
         notes.append(f"{exp.name}: the original's sensor bearings (bearings = atan): atan(y / x) of each input node, "
                      "so every sensor sits on the front half of the body (evolution.encodings.substrate)")
-    if exp.environment.get("colour_response") == "farther":
-        notes.append(f"{exp.name}: the original's colour reading (colour_response = farther): a block reads "
-                     "0.5 + d/2R, a wall d/2R, rising with distance d (gathering_env.reference.sensing)")
-    if exp.environment.get("block_sighting") == "rays":
-        notes.append(f"{exp.name}: the original's block sighting (block_sighting = rays): a sensor sees a block only "
-                     "along its axis and its two cone edges (gathering_env.reference.sensing)")
+    for (key, value), (what, does) in WORLD_NOTES.items():
+        if exp.environment.get(key) == value:
+            notes.append(f"{exp.name}: the original's {what} ({key} = {value}): {does}")
     if exp.environment.get("ir_response") == "khepera" or exp.environment.get("bottom_response") == "khepera":
         which = [k for k in ("ir_response", "bottom_response") if exp.environment.get(k) == "khepera"]
         notes.append(f"{exp.name}: the original's Khepera curve ({', '.join(f'{k} = khepera' for k in which)}): "
                      "infrared near-contact, bottom on/off at the robot's front (gathering_env.khepera)")
-    if exp.environment.get("wall_distance") == "original":
-        notes.append(f"{exp.name}: the original's wall distances (wall_distance = original): a wall is read at the "
-                     "distance the 2018 line formulas give, not its nearest point (gathering_env.reference.sensing)")
-    if exp.environment.get("attached_steering") == "original":
-        notes.append(f"{exp.name}: the original's steering of a welded robot (attached_steering = original): its "
-                     "inner wheel slows to a stop at 90 degrees off the zone centre, not 45 (gathering_env.reference.heuristics)")
-    if exp.environment.get("weld_spin") == "free":
-        notes.append(f"{exp.name}: the original's welded pair (weld_spin = free): a welded robot's friction torque "
-                     "lets go, so robot and block turn together (gathering_env.attachments)")
     if exp.species_bookkeeping == "encog" and not exp.multi_objective:
         notes.append(f"{exp.name}: Encog's species books (species_bookkeeping = encog): the best genome's species "
                      "pointer names the best species, which outlives its leader; speciation after scoring; generation "
