@@ -16,8 +16,11 @@ CHAMPION.json`` runs them in the world a champion was evolved in (its ``environm
 as ``drive_model`` or ``schedule``, but not a one-layout run's ``layout_seed``: the episodes' seeds
 lay out fresh worlds (with ``--own-layout`` they keep it, and the seeds vary only the shuffled
 schedule: how robust a one-layout champion is on its own layout); also its preset, steps and team
-size unless ``--environment``, ``--steps`` or ``--robots`` is given). A champion evolved in another world than the one
-compared in is named in a note on standard output.
+size unless ``--environment``, ``--steps`` or ``--robots`` is given). ``--world KEY=VALUE`` (repeatable)
+then sets one world parameter (a ``WorldConfig`` field; VALUE is read as TOML, else as a bare string:
+``--world weld_spin=free --world zone_size=[20,4]``), to ask what a champion would score in a
+world changed in one respect. A champion evolved in another world than the one compared in is
+named in a note on standard output.
 
 Policies: ``evolution.policies`` (the names ``--policy`` takes are listed there).
 """
@@ -27,6 +30,7 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
+from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +43,21 @@ from evolution.run.lock import LOCK_FILE, RunLock
 from evolution.run.protocol import PROTOCOLS, protocol_values
 from gathering_env import WorldConfig, parallel_env
 from gathering_env.config import ENVIRONMENT_PRESETS, INT_RANGES
+
+
+def world_setting(text: str) -> tuple[str, Any]:
+    """``KEY=VALUE`` from ``--world``: VALUE read as a TOML value (numbers, booleans, arrays,
+    quoted strings), else taken as a bare string (``weld_spin=free``)."""
+    import tomllib
+
+    key, sep, value = text.partition("=")
+    key = key.strip()
+    if not sep or not key.isidentifier():
+        raise argparse.ArgumentTypeError(f"{text!r} is not KEY=VALUE (a world parameter and its value)")
+    try:
+        return key, tomllib.loads(f"v = {value.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        return key, value.strip()
 
 
 def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
@@ -91,16 +110,20 @@ def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]
 
 
 def world_notes(policies: list[Policy], env_config: dict[str, Any]) -> list[str]:
-    """One line per policy whose own world (a champion's ``environment``) differs from ``env_config``
-    in a key other than the ones a comparison sets on purpose (preset, steps, team size, and the
-    layout: a one-layout run's ``layout_seed``)."""
+    """One line per policy whose own world (a champion's ``environment``; a key it does not record
+    has its default) differs from ``env_config`` in a key other than the ones a comparison sets on
+    purpose (preset, steps, team size, and the layout: a one-layout run's ``layout_seed``)."""
     notes = []
+    set_on_purpose = ("environment", "max_cycles", "num_robots", "layout_seed")
     compared = WorldConfig.from_kwargs(**env_config)
     for policy in policies:
-        own = {k: v for k, v in (policy.environment or {}).items()
-               if k not in ("environment", "max_cycles", "num_robots", "layout_seed")}
-        changed = [f"{k} = {v!r} (here {getattr(compared, k)!r})" for k, v in sorted(own.items())
-                   if hasattr(compared, k) and getattr(compared, k) != v]
+        if not policy.environment:
+            continue
+        own = WorldConfig.from_kwargs(**{**{k: v for k, v in policy.environment.items() if k not in set_on_purpose},
+                                         **{k: env_config[k] for k in set_on_purpose if k in env_config}})
+        changed = [f"{f.name} = {getattr(own, f.name)!r} (here {getattr(compared, f.name)!r})"
+                   for f in fields(WorldConfig) if f.name not in set_on_purpose
+                   and getattr(own, f.name) != getattr(compared, f.name)]
         if changed:
             notes.append(f"note: {policy.name} was made in another world: {', '.join(changed)}")
     return notes
@@ -216,6 +239,9 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--own-layout", action="store_true",
                         help="with --world-from a one-layout run's champion under the shuffled schedule: keep "
                              "its layout (layout_seed); the episodes' seeds then vary only the schedule")
+    parser.add_argument("--world", type=world_setting, action="append", default=[], metavar="KEY=VALUE",
+                        help="set one world parameter (a WorldConfig field) over the world chosen above; "
+                             "VALUE is TOML or a bare string (repeat)")
     parser.add_argument("--out", type=Path, default=Path("compare"),
                         help="folder for compare.md, compare.csv, compare-episodes.csv, compare.png (default compare/)")
     args = parser.parse_args(argv)
@@ -241,6 +267,16 @@ def compare_main(argv: list[str] | None = None) -> int:
             setattr(args, name, world.get(key, default))
     env_config = {**world, "environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots}
     WorldConfig.from_kwargs(**env_config)
+    if args.world:
+        for key, _ in args.world:
+            if key in ("environment", "max_cycles", "num_robots"):
+                raise UsageError(f"--world {key}: set by --environment, --steps or --robots; allowed: those options")
+        env_config.update(args.world)
+        try:
+            WorldConfig.from_kwargs(**env_config)
+        except (TypeError, ValueError) as e:
+            raise UsageError(f"--world {' '.join(f'{k}={v!r}' for k, v in args.world)}: {e}") from None
+        where += ", with " + ", ".join(f"{k} = {v!r}" for k, v in args.world)
     policies = [make_policy(p) for p in args.policy]
     for line in world_notes(policies, env_config):
         print(line)

@@ -693,6 +693,47 @@ def test_compare_runs_in_the_world_a_champion_was_evolved_in(tmp_path, monkeypat
     assert len(err) == 1 and "--world-from and --protocol" in err[0] and not (tmp_path / "c").exists()
 
 
+def test_compare_sets_one_world_key_and_names_a_champion_made_without_it(tmp_path, monkeypatch, capsys):
+    """gathering-compare --world KEY=VALUE changes one world parameter over the chosen world (VALUE
+    read as TOML, else as a bare string) and says so in the title; a champion whose record lacks the
+    key (so was made with its default) is named in a note; an unknown key, a bad value or a key that
+    has its own option is refused in one line, exit 2, nothing written."""
+    from evolution import compare as compare_module
+    from evolution.policies.base import Policy
+
+    assert compare_module.world_setting("weld_spin=free") == ("weld_spin", "free")
+    assert compare_module.world_setting("zone_depth = 4") == ("zone_depth", 4)
+    assert compare_module.world_setting("block_counts=[3, 2, 1]") == ("block_counts", [3, 2, 1])
+    assert compare_module.world_setting('schedule="shuffled"') == ("schedule", "shuffled")
+    seen = []
+    monkeypatch.setattr(compare_module, "compare", _recording_compare(seen))
+    args = ["--policy", "wander", "--episodes", "1", "--protocol", "original"]
+    assert compare_module.compare_main(args + ["--world", "weld_spin=held", "--world", "zone_depth=6",
+                                               "--out", str(tmp_path / "a")]) == 0
+    changed, = seen
+    assert changed == {**ORIGINAL["environment"], "environment": 2, "max_cycles": 10_000, "num_robots": 20,
+                       "weld_spin": "held", "zone_depth": 6}
+    assert "with weld_spin = 'held', zone_depth = 6" in (tmp_path / "a" / "compare.md").read_text()
+    # a version-10 record has no weld_spin: it was made with "held", and the compared world says "free"
+    v10 = {k: v for k, v in ORIGINAL["environment"].items() if k not in ("weld_spin", "attached_steering")}
+    note, = compare_module.world_notes([Policy("champion:v10", Morphology.khepera_iii(), None, environment=v10)],
+                                       {**ORIGINAL["environment"], "weld_spin": "free"})
+    assert "weld_spin = 'held' (here 'free')" in note and "attached_steering = 'sharp' (here 'original')" in note
+    capsys.readouterr()
+    for bad, says in ((["--world", "no_such_key=1"], "--world no_such_key=1: unknown world parameter"),
+                      (["--world", "weld_spin=spinning"], "--world weld_spin='spinning': weld_spin='spinning'; allowed"),
+                      (["--world", "max_cycles=5"], "--world max_cycles: set by --environment, --steps or --robots"),
+                      (["--world", "weld_spin"], "'weld_spin' is not KEY=VALUE")):
+        out = tmp_path / "bad"
+        try:
+            status = compare_module.compare_main(args + bad + ["--out", str(out)])
+        except SystemExit as e:   # argparse's own refusal
+            status = e.code
+        assert status == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and says in err[0] and not out.exists(), err
+
+
 def test_a_second_compare_into_the_same_folder_is_refused(tmp_path, capsys):
     """One writer per gathering-compare --out: while another holds it, one line, exit 2, no file."""
     from evolution.compare import compare_main
