@@ -11,7 +11,15 @@ import os
 import sys
 from pathlib import Path
 
-from evolution.guard import ArgumentParser, UsageError, check_output_file, command, int_arg
+from evolution.guard import (
+    ArgumentParser,
+    UsageError,
+    check_output_file,
+    command,
+    int_arg,
+    with_world_settings,
+    world_setting,
+)
 from evolution.run.experiment import LIMITS, METHODS, load_experiment
 from evolution.run.presets import (
     is_preset_name,
@@ -232,6 +240,9 @@ def replay_main(argv: list[str] | None = None) -> int:
                         help="episode length (default: the evolved or trained max_cycles; else 10 000)")
     parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0,
                         help="the episode's seed (default 0): an episode the team was not trained on")
+    parser.add_argument("--world", type=world_setting, action="append", default=[], metavar="KEY=VALUE",
+                        help="set one world parameter (a WorldConfig field) over the team's own world; "
+                             "VALUE is TOML or a bare string (repeat)")
     parser.add_argument("--out", type=Path, default=Path("team.gif"), help=".gif or .mp4")
     parser.add_argument("--frame-every", type=int_arg(1, 10**9), default=10, help="record every k-th step")
     parser.add_argument("--fps", type=int_arg(1, 1000), default=15, help="frames per second of the video (default 15)")
@@ -278,6 +289,7 @@ def replay_main(argv: list[str] | None = None) -> int:
         env_config["environment"] = args.environment
     if args.steps is not None:
         env_config["max_cycles"] = args.steps
+    env_config = with_world_settings(env_config, args.world, ("environment", "max_cycles"))
     try:
         info, path, frames = replay(team, env_config, args.seed, args.out, args.frame_every, args.fps,
                                     png=args.png, render_options=render_options, strip=args.strip,

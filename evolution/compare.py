@@ -36,28 +36,22 @@ from typing import Any
 
 import numpy as np
 
-from evolution.guard import ArgumentParser, UsageError, check_output_dir, command, int_arg, writing
+from evolution.guard import (
+    ArgumentParser,
+    UsageError,
+    check_output_dir,
+    command,
+    int_arg,
+    with_world_settings,
+    world_setting,
+    writing,
+)
 from evolution.policies import POLICY_NAMES, Policy, make_policy
 from evolution.run.experiment import LIMITS
 from evolution.run.lock import LOCK_FILE, RunLock
 from evolution.run.protocol import PROTOCOLS, protocol_values
 from gathering_env import WorldConfig, parallel_env
 from gathering_env.config import ENVIRONMENT_PRESETS, INT_RANGES
-
-
-def world_setting(text: str) -> tuple[str, Any]:
-    """``KEY=VALUE`` from ``--world``: VALUE read as a TOML value (numbers, booleans, arrays,
-    quoted strings), else taken as a bare string (``weld_spin=free``)."""
-    import tomllib
-
-    key, sep, value = text.partition("=")
-    key = key.strip()
-    if not sep or not key.isidentifier():
-        raise argparse.ArgumentTypeError(f"{text!r} is not KEY=VALUE (a world parameter and its value)")
-    try:
-        return key, tomllib.loads(f"v = {value.strip()}")["v"]
-    except tomllib.TOMLDecodeError:
-        return key, value.strip()
 
 
 def run_episode(env, policy: Policy, seed: int) -> dict[str, Any]:
@@ -267,15 +261,8 @@ def compare_main(argv: list[str] | None = None) -> int:
             setattr(args, name, world.get(key, default))
     env_config = {**world, "environment": args.environment, "max_cycles": args.steps, "num_robots": args.robots}
     WorldConfig.from_kwargs(**env_config)
+    env_config = with_world_settings(env_config, args.world, ("environment", "max_cycles", "num_robots"))
     if args.world:
-        for key, _ in args.world:
-            if key in ("environment", "max_cycles", "num_robots"):
-                raise UsageError(f"--world {key}: set by --environment, --steps or --robots; allowed: those options")
-        env_config.update(args.world)
-        try:
-            WorldConfig.from_kwargs(**env_config)
-        except (TypeError, ValueError) as e:
-            raise UsageError(f"--world {' '.join(f'{k}={v!r}' for k, v in args.world)}: {e}") from None
         where += ", with " + ", ".join(f"{k} = {v!r}" for k, v in args.world)
     policies = [make_policy(p) for p in args.policy]
     for line in world_notes(policies, env_config):

@@ -145,6 +145,42 @@ def float_arg(low: float, high: float = float("inf"), *, open_low: bool = False)
     return parse
 
 
+def world_setting(text: str) -> tuple[str, object]:
+    """``KEY=VALUE`` of a ``--world`` option: VALUE read as a TOML value (numbers, booleans, arrays,
+    quoted strings), else taken as a bare string (``weld_spin=free``)."""
+    import tomllib
+
+    key, sep, value = text.partition("=")
+    key = key.strip()
+    if not sep or not key.isidentifier():
+        raise argparse.ArgumentTypeError(f"{text!r} is not KEY=VALUE (a world parameter and its value)")
+    try:
+        return key, tomllib.loads(f"v = {value.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        return key, value.strip()
+
+
+#: World keys that commands set with options of their own (then ``--world`` may not).
+OWN_OPTIONS = {"environment": "--environment", "max_cycles": "--steps", "num_robots": "--robots"}
+
+
+def with_world_settings(env_config: dict, settings: list[tuple[str, object]], own: Iterable[str]) -> dict:
+    """``env_config`` with the ``--world`` settings over it, checked as a whole by ``WorldConfig``:
+    an unknown key, a refused value or a key of one of the command's own options (``own``, a
+    subset of ``OWN_OPTIONS``) is a ``UsageError`` naming the settings."""
+    from gathering_env import WorldConfig
+
+    for key, _ in settings:
+        if key in own:
+            raise UsageError(f"--world {key}: the command's option {OWN_OPTIONS[key]} sets it; allowed: that option")
+    changed = {**env_config, **dict(settings)}
+    try:
+        WorldConfig.from_kwargs(**changed)
+    except (TypeError, ValueError) as e:
+        raise UsageError(f"--world {' '.join(f'{k}={v!r}' for k, v in settings)}: {e}") from None
+    return changed
+
+
 def _check_creatable(path: Path, what: str) -> None:
     """``path`` does not exist: its nearest existing ancestor must be a writable folder."""
     parent = path.parent

@@ -722,7 +722,7 @@ def test_compare_sets_one_world_key_and_names_a_champion_made_without_it(tmp_pat
     capsys.readouterr()
     for bad, says in ((["--world", "no_such_key=1"], "--world no_such_key=1: unknown world parameter"),
                       (["--world", "weld_spin=spinning"], "--world weld_spin='spinning': weld_spin='spinning'; allowed"),
-                      (["--world", "max_cycles=5"], "--world max_cycles: set by --environment, --steps or --robots"),
+                      (["--world", "max_cycles=5"], "--world max_cycles: the command's option --steps sets it"),
                       (["--world", "weld_spin"], "'weld_spin' is not KEY=VALUE")):
         out = tmp_path / "bad"
         try:

@@ -77,6 +77,9 @@ def test_film_strip_panels_full_view(champion, tmp_path):
     (["--strip", "0,10"], "error: --strip: a film strip needs a picture file; allowed: --png FILE.png"),
     (["--png", "s.jpg"], "error: --png s.jpg: suffix '.jpg'; allowed: .png"),
     (["--sensors-png", "s.gif"], "error: --sensors-png s.gif: suffix '.gif'; allowed: .png"),
+    (["--world", "max_cycles=5"], "error: --world max_cycles: the command's option --steps sets it; allowed: that option"),
+    (["--world", "weld_spin=loose"], "error: --world weld_spin='loose': weld_spin='loose'; allowed: 'held', 'free'"),
+    (["--world", "zone_width=-1"], "error: --world zone_width=-1: "),
 ])
 def test_bad_replay_options_exit_2_with_one_line(champion, tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)
@@ -97,6 +100,20 @@ def test_replay_says_its_episode_is_unseen_and_quotes_the_training_ft(champion, 
                         "episodes; one new episode can score far from it")
     assert replay_main([str(champion), "--steps", "20", "--out", str(tmp_path / "u.gif")]) == 0
     assert "an unseen episode (seed 0) in a changed world (max_cycles): " in capsys.readouterr().out
+
+
+def test_replay_in_a_world_changed_by_world_settings(champion, tmp_path, capsys):
+    """--world KEY=VALUE replays the team in its world with that key changed (here fewer robots:
+    the panel-less frames then hold fewer robot pixels) and the note names the changed key."""
+    out = tmp_path / "a.gif"
+    assert replay_main([str(champion), "--out", str(out), "--no-panel", "--frame-every", "40"]) == 0
+    capsys.readouterr()
+    fewer = tmp_path / "b.gif"
+    assert replay_main([str(champion), "--out", str(fewer), "--no-panel", "--frame-every", "40",
+                        "--world", "num_robots=2", "--world", "zone_depth=6"]) == 0
+    assert "in a changed world (num_robots, zone_depth)" in capsys.readouterr().out
+    first, changed = imageio.mimread(out)[0], imageio.mimread(fewer)[0]
+    assert first.shape == changed.shape and not np.array_equal(first, changed)
 
 
 def test_a_per_run_champion_replayed_on_its_layout_scores_its_training_ft(tmp_path, capsys):
