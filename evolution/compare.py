@@ -18,7 +18,7 @@ lay out fresh worlds (with ``--own-layout`` they keep it, and the seeds vary onl
 schedule: how robust a one-layout champion is on its own layout); also its preset, steps and team
 size unless ``--environment``, ``--steps`` or ``--robots`` is given). ``--world KEY=VALUE`` (repeatable)
 then sets one world parameter (a ``WorldConfig`` field; VALUE is read as TOML, else as a bare string:
-``--world weld_spin=free --world zone_size=[20,4]``), to ask what a champion would score in a
+``--world weld_spin=free --world block_counts=[3,2,1]``), to ask what a champion would score in a
 world changed in one respect. A champion evolved in another world than the one compared in is
 named in a note on standard output.
 
