@@ -69,16 +69,21 @@ def pickup_candidates(world: GatheringWorld, gathered: np.ndarray) -> list[tuple
     return [(int(r), int(b)) for r, b in zip(free_robots[inside], blocks[inside])]
 
 
+def zone_heading_error(world: GatheringWorld, robots: np.ndarray) -> np.ndarray:
+    """Each robot's heading error to the zone centre: the bearing of the centre less the robot's
+    heading, in [-pi, pi) (positive: the centre lies to its left)."""
+    cx, cy = world.config.zone_centre
+    # libm's atan2 (as the compiled kernel uses), not numpy's own SIMD arctan2, which differs
+    # from it in the last bit: both kernels must steer identically.
+    bearing = np.array([math.atan2(cy - y, cx - x) for x, y in world.robot_pos[robots].tolist()])
+    return _wrap(bearing - world.robot_angle[robots])
+
+
 def attached_wheels(world: GatheringWorld, robots: np.ndarray) -> np.ndarray:
     """(len(robots), 2) full-power wheel commands steering towards the zone centre
     (``WorldConfig.attached_steering``)."""
     cfg = world.config
-    cx, cy = cfg.zone_centre
-    pos = world.robot_pos[robots]
-    # libm's atan2 (as the compiled kernel uses), not numpy's own SIMD arctan2, which differs
-    # from it in the last bit: both kernels must steer identically.
-    bearing = np.array([math.atan2(cy - y, cx - x) for x, y in pos.tolist()])
-    error = _wrap(bearing - world.robot_angle[robots])
+    error = zone_heading_error(world, robots)
     if cfg.attached_steering == "original":
         # Heuristic.wheelDriveForTargetAngle's quadrants: backwards from +90 degrees on, forwards
         # at -90; the outer wheel at full power, the inner one slowed linearly to 0 at 90 degrees.
