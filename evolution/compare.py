@@ -19,8 +19,10 @@ schedule: how robust a one-layout champion is on its own layout); also its prese
 size unless ``--environment``, ``--steps`` or ``--robots`` is given). ``--world KEY=VALUE`` (repeatable)
 then sets one world parameter (a ``WorldConfig`` field; VALUE is read as TOML, else as a bare string:
 ``--world weld_spin=free --world block_counts=[3,2,1]``), to ask what a champion would score in a
-world changed in one respect. A champion evolved in another world than the one compared in is
-named in a note on standard output.
+world changed in one respect; ``--paired-with FOLDER`` then pairs each policy with itself in an
+earlier comparison written to FOLDER (the same policies and seeds, in the world before the change),
+seed by seed as above, in a second table of ``compare.md``. A champion evolved in another world
+than the one compared in is named in a note on standard output.
 
 Policies: ``evolution.policies`` (the names ``--policy`` takes are listed there).
 """
@@ -81,10 +83,7 @@ def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]
     per seed in ``seeds`` order."""
     env = parallel_env(**env_config)
     rows = []
-    seen: dict[str, int] = {}
-    for policy in policies:
-        seen[policy.name] = seen.get(policy.name, 0) + 1
-        name = policy.name if seen[policy.name] == 1 else f"{policy.name}#{seen[policy.name]}"
+    for policy, name in zip(policies, row_names(policies)):
         episodes = [run_episode(env, policy, s) for s in seeds]
         ft = np.array([e["ft"] for e in episodes])
         by_type = np.array([e["by_type"] for e in episodes], dtype=float)
@@ -101,6 +100,16 @@ def compare(policies: list[Policy], env_config: dict[str, Any], seeds: list[int]
                           for s, e in zip(seeds, episodes)],
         })
     return rows
+
+
+def row_names(policies: list[Policy]) -> list[str]:
+    """Each policy's row name: its name, and ``name#k`` for the k-th policy of one name."""
+    seen: dict[str, int] = {}
+    names = []
+    for policy in policies:
+        seen[policy.name] = seen.get(policy.name, 0) + 1
+        names.append(policy.name if seen[policy.name] == 1 else f"{policy.name}#{seen[policy.name]}")
+    return names
 
 
 def world_notes(policies: list[Policy], env_config: dict[str, Any]) -> list[str]:
@@ -152,12 +161,50 @@ def paired_lines(rows: list[dict[str, Any]]) -> list[str]:
     lines = ["", f"Paired with {first['policy']} on the same seeds (difference = policy − {first['policy']}):", "",
              "| policy | ft difference (mean ± standard error) | seeds higher / equal / lower | Wilcoxon signed-rank p |",
              "|---|---|---|---|"]
-    for r in rows[1:]:
-        d = paired_difference([e["ft"] for e in r[PER_EPISODE]], base)
-        p = "—" if np.isnan(d["wilcoxon_p"]) else f"{d['wilcoxon_p']:.2g}"
-        lines.append(f"| {r['policy']} | {d['diff']:+.2f} ± {d['diff_se']:.2f} | "
-                     f"{d['higher']} / {d['equal']} / {d['lower']} | {p} |")
+    lines += [paired_row(r["policy"], [e["ft"] for e in r[PER_EPISODE]], base) for r in rows[1:]]
     return lines
+
+
+def paired_row(name: str, values: list[float], baseline: list[float]) -> str:
+    """One row of a paired table: ``values`` against ``baseline`` (``paired_difference``)."""
+    d = paired_difference(values, baseline)
+    p = "—" if np.isnan(d["wilcoxon_p"]) else f"{d['wilcoxon_p']:.2g}"
+    return (f"| {name} | {d['diff']:+.2f} ± {d['diff_se']:.2f} | "
+            f"{d['higher']} / {d['equal']} / {d['lower']} | {p} |")
+
+
+def earlier_episodes(folder: Path, names: list[str], seeds: list[int]) -> dict[str, list[float]]:
+    """``--paired-with FOLDER``: the ft of each policy in ``names`` on each of ``seeds``, from the
+    ``compare-episodes.csv`` an earlier ``gathering-compare`` wrote there (the same policies, named
+    as there, on the same seeds); anything else is a ``UsageError`` naming the file."""
+    path = folder / "compare-episodes.csv"
+    if not path.is_file():
+        raise UsageError(f"--paired-with {folder}: no compare-episodes.csv in it; allowed: the --out folder of an "
+                         "earlier gathering-compare")
+    found: dict[str, dict[int, float]] = {}
+    with open(path, newline="") as f:
+        for line, row in enumerate(csv.DictReader(f), start=2):
+            try:
+                found.setdefault(row["policy"], {})[int(row["seed"])] = float(row["ft"])
+            except (KeyError, TypeError, ValueError):
+                raise UsageError(f"{path}:{line}: not a row of policy, seed and ft; allowed: the file as "
+                                 "gathering-compare wrote it") from None
+    for name in names:
+        if name not in found:
+            raise UsageError(f"--paired-with {folder}: no episodes of {name} in {path.name}; allowed: the policies "
+                             f"compared there ({', '.join(sorted(found))})")
+        if sorted(found[name]) != sorted(seeds):
+            raise UsageError(f"--paired-with {folder}: {name} ran seeds {min(found[name])}..{max(found[name])} "
+                             f"({len(found[name])}) there; allowed: the same --seed and --episodes")
+    return {name: [found[name][s] for s in seeds] for name in names}
+
+
+def paired_with_lines(rows: list[dict[str, Any]], earlier: dict[str, list[float]], where: Path) -> list[str]:
+    """The table of ``--paired-with``: each policy here against itself in the earlier comparison."""
+    lines = ["", f"Paired with the same policies in {where} on the same seeds (difference = here − there):", "",
+             "| policy | ft difference (mean ± standard error) | seeds higher / equal / lower | Wilcoxon signed-rank p |",
+             "|---|---|---|---|"]
+    return lines + [paired_row(r["policy"], [e["ft"] for e in r[PER_EPISODE]], earlier[r["policy"]]) for r in rows]
 
 
 #: Every file ``write_outputs`` writes: the output folder may hold these (an earlier
@@ -167,7 +214,8 @@ COMPARE_FILES = ("compare.csv", "compare.md", "compare.png", "compare-episodes.c
 PER_EPISODE = "per_episode"
 
 
-def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Path, Path, Path]:
+def write_outputs(rows: list[dict[str, Any]], out: Path, title: str,
+                  extra: list[str] = ()) -> tuple[Path, Path, Path]:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -197,7 +245,7 @@ def write_outputs(rows: list[dict[str, Any]], out: Path, title: str) -> tuple[Pa
                      f"{r['medium']:.1f} | {r['large']:.1f} | {r['finished']}/{r['episodes']} | {steps} |")
     md_path = out / "compare.md"
     with writing(md_path):
-        md_path.write_text(f"{title}\n\n" + "\n".join(lines + paired_lines(rows)) + "\n")
+        md_path.write_text(f"{title}\n\n" + "\n".join(lines + paired_lines(rows) + list(extra)) + "\n")
     fig, ax = plt.subplots(figsize=(1.6 + 1.3 * len(rows), 3.6), constrained_layout=True)
     ax.bar(range(len(rows)), [r["ft_mean"] for r in rows], yerr=[r["ft_se"] or 0.0 for r in rows], capsize=4,
            color="tab:blue")
@@ -236,6 +284,9 @@ def compare_main(argv: list[str] | None = None) -> int:
     parser.add_argument("--world", type=world_setting, action="append", default=[], metavar="KEY=VALUE",
                         help="set one world parameter (a WorldConfig field) over the world chosen above; "
                              "VALUE is TOML or a bare string (repeat)")
+    parser.add_argument("--paired-with", type=Path, metavar="FOLDER",
+                        help="pair each policy with itself in an earlier comparison's --out folder (the same "
+                             "policies and seeds, another world): a paired table in compare.md")
     parser.add_argument("--out", type=Path, default=Path("compare"),
                         help="folder for compare.md, compare.csv, compare-episodes.csv, compare.png (default compare/)")
     args = parser.parse_args(argv)
@@ -265,6 +316,15 @@ def compare_main(argv: list[str] | None = None) -> int:
     if args.world:
         where += ", with " + ", ".join(f"{k} = {v!r}" for k, v in args.world)
     policies = [make_policy(p) for p in args.policy]
+    seeds = list(range(args.seed, args.seed + args.episodes))
+    earlier = None
+    if args.paired_with is not None:
+        if args.episodes < 2:
+            raise UsageError(f"--paired-with needs at least 2 episodes; allowed: --episodes {args.episodes} -> 2 or more")
+        if args.paired_with.resolve() == args.out.resolve():
+            raise UsageError(f"--paired-with {args.paired_with}: the same folder as --out (it would be replaced); "
+                             "allowed: another --out")
+        earlier = earlier_episodes(args.paired_with, row_names(policies), seeds)
     for line in world_notes(policies, env_config):
         print(line)
     title = (f"environment {args.environment}{where}, "
@@ -272,8 +332,9 @@ def compare_main(argv: list[str] | None = None) -> int:
              f"{args.episodes} episodes (seeds {args.seed}..{args.seed + args.episodes - 1})")
     # one writer per --out: a second copy stops here, before any episode
     with RunLock(args.out, what="output folder", by="another gathering-compare"):
-        rows = compare(policies, env_config, list(range(args.seed, args.seed + args.episodes)))
-        md, csv_path, png = write_outputs(rows, args.out, title)
+        rows = compare(policies, env_config, seeds)
+        extra = paired_with_lines(rows, earlier, args.paired_with) if earlier is not None else []
+        md, csv_path, png = write_outputs(rows, args.out, title, extra)
     print(md.read_text())
     episodes = args.out / "compare-episodes.csv"
     written = [md, csv_path, *([episodes] if episodes.exists() else []), png]

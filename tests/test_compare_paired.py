@@ -115,3 +115,67 @@ def test_two_champions_of_one_run_keep_their_file_names():
     assert champion_name("docs/evidence/original-S1-v4/champion-gen55.json") == "champion:original-S1-v4/champion-gen55"
     assert champion_name("champion-gen10.json") == "champion:champion-gen10"
     assert champion_name("champion.json") == "champion:champion.json"
+
+
+def fake_compare(policies, env_config, seeds):
+    """Stands in for the episodes: policy k scores seed * zone_depth + k, so a deeper zone raises
+    each seed's ft by a different amount (seed * the change)."""
+    from evolution.compare import row_names
+
+    depth = env_config.get("zone_depth", 8.0)
+    return [row(name, [s * depth + k for s in seeds]) | {PER_EPISODE: [
+        {"policy": name, "seed": s, "ft": s * depth + k, "small": 0, "medium": 0, "large": 0,
+         "finished": False, "steps": 10} for s in seeds]}
+        for k, name in enumerate(row_names(policies))]
+
+
+def test_paired_with_pairs_each_policy_with_itself_in_an_earlier_comparison(tmp_path, monkeypatch):
+    """--paired-with FOLDER: each policy here against the same policy there, seed by seed
+    (difference = here - there); the two wander policies keep their row names (wander#2)."""
+    from evolution import compare as compare_module
+
+    monkeypatch.setattr(compare_module, "compare", fake_compare)
+    base = ["--policy", "wander", "--policy", "wander", "--episodes", "4", "--seed", "1"]
+    assert compare_main(base + ["--out", str(tmp_path / "before")]) == 0
+    assert compare_main(base + ["--world", "zone_depth=6", "--paired-with", str(tmp_path / "before"),
+                                "--out", str(tmp_path / "after")]) == 0
+    text = (tmp_path / "after" / "compare.md").read_text()
+    table = text.split(f"Paired with the same policies in {tmp_path / 'before'}")[1]
+    # seeds 1..4 at depth 6 against depth 8: differences -2, -4, -6, -8; mean -5, sd sqrt(20/3), se sd/2;
+    # all lower, so the two-sided exact p is 2/16
+    se = np.sqrt(20 / 3) / 2
+    assert f"| wander | -5.00 ± {se:.2f} | 0 / 0 / 4 | 0.12 |" in table
+    assert f"| wander#2 | -5.00 ± {se:.2f} | 0 / 0 / 4 | 0.12 |" in table
+
+
+@pytest.mark.parametrize("case, says", [
+    ("no-file", "no compare-episodes.csv in it"),
+    ("other-policy", "no episodes of random in compare-episodes.csv; allowed: the policies compared there (wander)"),
+    ("other-seeds", "wander ran seeds 1..4 (4) there; allowed: the same --seed and --episodes"),
+    ("same-folder", "the same folder as --out"),
+    ("one-episode", "--paired-with needs at least 2 episodes"),
+    ("broken", "compare-episodes.csv:3: not a row of policy, seed and ft"),
+])
+def test_paired_with_refuses_what_it_cannot_pair_in_one_line(tmp_path, monkeypatch, capsys, case, says):
+    from evolution import compare as compare_module
+
+    monkeypatch.setattr(compare_module, "compare", fake_compare)
+    before = tmp_path / "before"
+    assert compare_main(["--policy", "wander", "--episodes", "4", "--seed", "1", "--out", str(before)]) == 0
+    args = {"no-file": ["--policy", "wander", "--episodes", "4", "--seed", "1", "--paired-with", str(tmp_path)],
+            "other-policy": ["--policy", "random", "--episodes", "4", "--seed", "1", "--paired-with", str(before)],
+            "other-seeds": ["--policy", "wander", "--episodes", "4", "--seed", "2", "--paired-with", str(before)],
+            "same-folder": ["--policy", "wander", "--episodes", "4", "--seed", "1", "--paired-with", str(before)],
+            "one-episode": ["--policy", "wander", "--episodes", "1", "--seed", "1", "--paired-with", str(before)],
+            "broken": ["--policy", "wander", "--episodes", "4", "--seed", "1", "--paired-with", str(before)]}[case]
+    out = before if case == "same-folder" else tmp_path / "after"
+    if case == "broken":
+        episodes = before / "compare-episodes.csv"
+        lines = episodes.read_text().splitlines()
+        episodes.write_text("\n".join(lines[:2] + ["wander,x,1.0"] + lines[3:]) + "\n")
+    capsys.readouterr()
+    kept = {p.name: p.read_bytes() for p in before.iterdir()}
+    assert compare_main(args + ["--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and says in err[0], err
+    assert not (tmp_path / "after").exists() and {p.name: p.read_bytes() for p in before.iterdir()} == kept
