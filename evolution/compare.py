@@ -112,6 +112,19 @@ def row_names(policies: list[Policy]) -> list[str]:
     return names
 
 
+def champion_world(champion: Policy, path: Path, own_layout: bool) -> dict[str, Any]:
+    """The world keys a champion was evolved in, for its episodes here: a one-layout run's layout
+    (``layout_seed``) is dropped, so the episodes' seeds lay out fresh worlds, unless ``own_layout``
+    (``--own-layout``: then the seeds vary only the shuffled schedule), which needs that key."""
+    world = dict(champion.environment or {})
+    if own_layout and "layout_seed" not in world:
+        raise UsageError(f"--own-layout: {path} has no layout_seed (not a one-layout run under the "
+                         "shuffled schedule); allowed: such a champion, or no --own-layout")
+    if not own_layout:
+        world.pop("layout_seed", None)
+    return world
+
+
 def world_notes(policies: list[Policy], env_config: dict[str, Any]) -> list[str]:
     """One line per policy whose own world (a champion's ``environment``; a key it does not record
     has its default) differs from ``env_config`` in a key other than the ones a comparison sets on
@@ -296,12 +309,7 @@ def compare_main(argv: list[str] | None = None) -> int:
     if args.own_layout and args.world_from is None:
         raise UsageError("--own-layout: keeps the layout of --world-from's champion; allowed: with --world-from")
     if args.world_from is not None:
-        world = dict(make_policy(f"champion:{args.world_from}").environment or {})
-        if args.own_layout and "layout_seed" not in world:
-            raise UsageError(f"--own-layout: {args.world_from} has no layout_seed (not a one-layout run under the "
-                             "shuffled schedule); allowed: such a champion, or no --own-layout")
-        if not args.own_layout:
-            world.pop("layout_seed", None)   # a one-layout run's layout: compared on fresh ones
+        world = champion_world(make_policy(f"champion:{args.world_from}"), args.world_from, args.own_layout)
         where = f", the world of {args.world_from}{' on its own layout' if args.own_layout else ''}"
     else:
         world = protocol_values(args.protocol or "paper")["environment"]

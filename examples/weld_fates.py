@@ -22,7 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from evolution.guard import ArgumentParser, UsageError, command, int_arg, with_world_settings, world_setting
+from evolution.compare import champion_world
+from evolution.guard import ArgumentParser, command, int_arg, with_world_settings, world_setting
 from evolution.policies import make_policy
 from evolution.run.experiment import LIMITS
 from gathering_env import parallel_env
@@ -94,12 +95,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int_arg(*LIMITS["seed"]), default=0, help="first episode seed (default 0)")
     args = parser.parse_args(argv)
     policy = make_policy(f"champion:{args.champion}")
-    world = dict(policy.environment or {})
-    if args.own_layout and "layout_seed" not in world:
-        raise UsageError(f"--own-layout: {args.champion} has no layout_seed (not a one-layout run under the "
-                         "shuffled schedule); allowed: such a champion, or no --own-layout")
-    if not args.own_layout:
-        world.pop("layout_seed", None)
+    world = champion_world(policy, args.champion, args.own_layout)
     env = parallel_env(**with_world_settings(world, args.world, ()))
     episodes, welds = [], []
     for seed in range(args.seed, args.seed + args.episodes):

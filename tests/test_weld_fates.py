@@ -70,7 +70,9 @@ def test_every_welded_robot_step_belongs_to_one_weld(fates):
 def test_bad_input_is_one_line_exit_2(fates, tmp_path, capsys):
     for args, says in (([str(tmp_path / "none.json")], "champion file not found"),
                        ([str(CHAMPION), "--world", "weld_spin=loose"], "--world weld_spin='loose'"),
-                       ([str(CHAMPION), "--world", "max_cycles=-1"], "--world max_cycles=-1")):
+                       ([str(CHAMPION), "--world", "max_cycles=-1"], "--world max_cycles=-1"),
+                       ([str(ROOT / "docs" / "evidence" / "original-S1-force" / "champion.json"), "--own-layout"],
+                        "has no layout_seed")):
         assert fates.main(args) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and says in err[0], err
