@@ -166,7 +166,7 @@ def carry(kernel: str, weld_spin: str, block: tuple[float, float] = (5.0, 10.0),
 def test_a_welded_pair_turns_only_with_weld_spin_free(kernel):
     """The zone centre lies 27.5 degrees to the right of a welded robot's heading. The original's
     own classes (measured with its RobotObject, ResourceObject and Box2D world, fixed order)
-    arc the block into the zone in 943 steps, whatever the robot's friction torque. Held by that
+    arc the block into the zone in 943 steps (its friction joint takes only a share of the robot's spin). Held by that
     torque, ours drives straight on east, never turning; with weld_spin = "free" it arcs right and
     gathers the block (in 766 steps), the same on both kernels."""
     steps, x, y, heading = carry(kernel, "held")
