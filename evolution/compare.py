@@ -31,6 +31,8 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
+import math
 import sys
 from dataclasses import fields
 from pathlib import Path
@@ -171,19 +173,22 @@ def paired_lines(rows: list[dict[str, Any]]) -> list[str]:
         return []
     first = rows[0]
     base = [e["ft"] for e in first[PER_EPISODE]]
-    lines = ["", f"Paired with {first['policy']} on the same seeds (difference = policy − {first['policy']}):", "",
+    return paired_table(f"Paired with {first['policy']} on the same seeds (difference = policy − {first['policy']}):",
+                        [(r["policy"], [e["ft"] for e in r[PER_EPISODE]], base) for r in rows[1:]])
+
+
+def paired_table(heading: str, pairs: list[tuple[str, list[float], list[float]]]) -> list[str]:
+    """A paired table of ``compare.md``: one row per (name, values, baseline), the values against
+    the baseline seed by seed (``paired_difference``)."""
+    lines = ["", heading, "",
              "| policy | ft difference (mean ± standard error) | seeds higher / equal / lower | Wilcoxon signed-rank p |",
              "|---|---|---|---|"]
-    lines += [paired_row(r["policy"], [e["ft"] for e in r[PER_EPISODE]], base) for r in rows[1:]]
+    for name, values, baseline in pairs:
+        d = paired_difference(values, baseline)
+        p = "—" if np.isnan(d["wilcoxon_p"]) else f"{d['wilcoxon_p']:.2g}"
+        lines.append(f"| {name} | {d['diff']:+.2f} ± {d['diff_se']:.2f} | "
+                     f"{d['higher']} / {d['equal']} / {d['lower']} | {p} |")
     return lines
-
-
-def paired_row(name: str, values: list[float], baseline: list[float]) -> str:
-    """One row of a paired table: ``values`` against ``baseline`` (``paired_difference``)."""
-    d = paired_difference(values, baseline)
-    p = "—" if np.isnan(d["wilcoxon_p"]) else f"{d['wilcoxon_p']:.2g}"
-    return (f"| {name} | {d['diff']:+.2f} ± {d['diff_se']:.2f} | "
-            f"{d['higher']} / {d['equal']} / {d['lower']} | {p} |")
 
 
 def earlier_episodes(folder: Path, names: list[str], seeds: list[int]) -> dict[str, list[float]]:
@@ -194,14 +199,23 @@ def earlier_episodes(folder: Path, names: list[str], seeds: list[int]) -> dict[s
     if not path.is_file():
         raise UsageError(f"--paired-with {folder}: no compare-episodes.csv in it; allowed: the --out folder of an "
                          "earlier gathering-compare")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise UsageError(f"{path}: not UTF-8 text; allowed: the file as gathering-compare wrote it") from None
     found: dict[str, dict[int, float]] = {}
-    with open(path, newline="") as f:
-        for line, row in enumerate(csv.DictReader(f), start=2):
-            try:
-                found.setdefault(row["policy"], {})[int(row["seed"])] = float(row["ft"])
-            except (KeyError, TypeError, ValueError):
-                raise UsageError(f"{path}:{line}: not a row of policy, seed and ft; allowed: the file as "
-                                 "gathering-compare wrote it") from None
+    rows = csv.DictReader(io.StringIO(text, newline=""))
+    line = 1
+    try:
+        for number, row in enumerate(rows, start=2):
+            line = number
+            ft = float(row["ft"])
+            if not math.isfinite(ft):
+                raise ValueError(ft)
+            found.setdefault(row["policy"], {})[int(row["seed"])] = ft
+    except (KeyError, TypeError, ValueError, csv.Error):
+        raise UsageError(f"{path}:{line}: not a row of policy, seed and a finite ft; allowed: the file as "
+                         "gathering-compare wrote it") from None
     for name in names:
         if name not in found:
             raise UsageError(f"--paired-with {folder}: no episodes of {name} in {path.name}; allowed: the policies "
@@ -214,10 +228,8 @@ def earlier_episodes(folder: Path, names: list[str], seeds: list[int]) -> dict[s
 
 def paired_with_lines(rows: list[dict[str, Any]], earlier: dict[str, list[float]], where: Path) -> list[str]:
     """The table of ``--paired-with``: each policy here against itself in the earlier comparison."""
-    lines = ["", f"Paired with the same policies in {where} on the same seeds (difference = here − there):", "",
-             "| policy | ft difference (mean ± standard error) | seeds higher / equal / lower | Wilcoxon signed-rank p |",
-             "|---|---|---|---|"]
-    return lines + [paired_row(r["policy"], [e["ft"] for e in r[PER_EPISODE]], earlier[r["policy"]]) for r in rows]
+    return paired_table(f"Paired with the same policies in {where} on the same seeds (difference = here − there):",
+                        [(r["policy"], [e["ft"] for e in r[PER_EPISODE]], earlier[r["policy"]]) for r in rows])
 
 
 #: Every file ``write_outputs`` writes: the output folder may hold these (an earlier

@@ -152,8 +152,8 @@ def world_setting(text: str) -> tuple[str, object]:
 
     key, sep, value = text.partition("=")
     key = key.strip()
-    if not sep or not key.isidentifier():
-        raise argparse.ArgumentTypeError(f"{text!r} is not KEY=VALUE (a world parameter and its value)")
+    if not sep or not key.isidentifier() or "\n" in value or "\r" in value:
+        raise argparse.ArgumentTypeError(f"{text!r} is not KEY=VALUE (a world parameter and its value, on one line)")
     try:
         return key, tomllib.loads(f"v = {value.strip()}")["v"]
     except tomllib.TOMLDecodeError:

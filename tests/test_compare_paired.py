@@ -154,7 +154,9 @@ def test_paired_with_pairs_each_policy_with_itself_in_an_earlier_comparison(tmp_
     ("other-seeds", "wander ran seeds 1..4 (4) there; allowed: the same --seed and --episodes"),
     ("same-folder", "the same folder as --out"),
     ("one-episode", "--paired-with needs at least 2 episodes"),
-    ("broken", "compare-episodes.csv:3: not a row of policy, seed and ft"),
+    ("broken", "compare-episodes.csv:3: not a row of policy, seed and a finite ft"),
+    ("nan", "compare-episodes.csv:3: not a row of policy, seed and a finite ft"),
+    ("binary", "compare-episodes.csv: not UTF-8 text"),
 ])
 def test_paired_with_refuses_what_it_cannot_pair_in_one_line(tmp_path, monkeypatch, capsys, case, says):
     from evolution import compare as compare_module
@@ -167,12 +169,17 @@ def test_paired_with_refuses_what_it_cannot_pair_in_one_line(tmp_path, monkeypat
             "other-seeds": ["--policy", "wander", "--episodes", "4", "--seed", "2", "--paired-with", str(before)],
             "same-folder": ["--policy", "wander", "--episodes", "4", "--seed", "1", "--paired-with", str(before)],
             "one-episode": ["--policy", "wander", "--episodes", "1", "--seed", "1", "--paired-with", str(before)],
-            "broken": ["--policy", "wander", "--episodes", "4", "--seed", "1", "--paired-with", str(before)]}[case]
+            "broken": ["--policy", "wander", "--episodes", "4", "--seed", "1", "--paired-with", str(before)]}
+    args["nan"] = args["binary"] = args["broken"]
+    args = args[case]
     out = before if case == "same-folder" else tmp_path / "after"
-    if case == "broken":
-        episodes = before / "compare-episodes.csv"
-        lines = episodes.read_text().splitlines()
-        episodes.write_text("\n".join(lines[:2] + ["wander,x,1.0"] + lines[3:]) + "\n")
+    episodes = before / "compare-episodes.csv"
+    lines = episodes.read_text().splitlines()
+    if case in ("broken", "nan"):
+        bad = "wander,x,1.0" if case == "broken" else "wander,2,nan"
+        episodes.write_text("\n".join(lines[:2] + [bad] + lines[3:]) + "\n")
+    if case == "binary":
+        episodes.write_bytes(b"policy,seed,ft\n\xff\xfe,1,2\n")
     capsys.readouterr()
     kept = {p.name: p.read_bytes() for p in before.iterdir()}
     assert compare_main(args + ["--out", str(out)]) == 2

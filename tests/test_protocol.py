@@ -3,6 +3,7 @@ behaviour or a hand value, the bundle's rules, its presets, and resuming a run u
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import shutil
@@ -705,6 +706,8 @@ def test_compare_sets_one_world_key_and_names_a_champion_made_without_it(tmp_pat
     assert compare_module.world_setting("zone_depth = 4") == ("zone_depth", 4)
     assert compare_module.world_setting("block_counts=[3, 2, 1]") == ("block_counts", [3, 2, 1])
     assert compare_module.world_setting('schedule="shuffled"') == ("schedule", "shuffled")
+    with pytest.raises(argparse.ArgumentTypeError, match="on one line"):  # a second TOML key smuggled in
+        compare_module.world_setting("zone_depth=4\nweld_spin = 'free'")
     seen = []
     monkeypatch.setattr(compare_module, "compare", _recording_compare(seen))
     args = ["--policy", "wander", "--episodes", "1", "--protocol", "original"]
