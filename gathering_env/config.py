@@ -189,9 +189,10 @@ class WorldConfig:
     their friction torques, which it never does at one robot per block). 'free': the robot's
     friction torque is released while it is welded, so the pair turns against the block's
     friction torque, its sliding friction and the robot's traction impulse. Measured on the
-    original's own classes, the pair arcs its block into the zone from up to ~66 degrees off:
-    Box2D's friction joint takes only a share of the robot's spin each step, whatever its cap.
-    'free' takes none, so its pair turns somewhat more readily than the original's
+    original's own classes, the pair arcs its block into the zone from up to ~66 degrees off,
+    an artefact of Box2D's unconverged solver (its position pass turns the pair past the
+    friction; with 20 velocity iterations or no position pass it holds, as 'held' does).
+    'free' lets the pair turn somewhat more readily than the original's
     (docs/fidelity.md, "The welded robot")."""
     collision_avoidance: bool = False
     """Turn away from robots/walls just ahead, overriding the controller (original option, off)."""
