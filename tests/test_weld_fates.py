@@ -47,6 +47,15 @@ def test_tables_bin_count_and_median_by_hand(fates):
     assert "| 0–15° | 2 | 2 | 0 | 200 |" in text          # median of 100 and 300
     assert "| 15–45° | 2 | 1 | 1 | 10 |" in text
     assert "| 45–90° | 4 | 3 | 1 | 7 |" in text            # 90 itself falls in the last bin
+    finer = fates.tables([], welds, (0.0, 66.5, 81.0, 90.0))
+    assert "| 0–66.5° | 5 | 4 | 1 | 55 |" in finer        # 5, 14.9, 15, 44, 60: median of 100, 300, 10, 7
+    assert "| 66.5–81° | 2 | 1 | 1 | 1 |" in finer and "| 81–90° | 1 | 1 | 0 | 9 |" in finer
+
+
+@pytest.mark.parametrize("text, edges", [("0,15,45,90", (0.0, 15.0, 45.0, 90.0)), ("0,66.5,90", (0.0, 66.5, 90.0)),
+                                         ("0,90", (0.0, 90.0))])
+def test_bins_are_read_as_rising_degrees(fates, text, edges):
+    assert fates.bins_arg(text) == edges
 
 
 def test_every_welded_robot_step_belongs_to_one_weld(fates):
@@ -71,8 +80,14 @@ def test_bad_input_is_one_line_exit_2(fates, tmp_path, capsys):
     for args, says in (([str(tmp_path / "none.json")], "champion file not found"),
                        ([str(CHAMPION), "--world", "weld_spin=loose"], "--world weld_spin='loose'"),
                        ([str(CHAMPION), "--world", "max_cycles=-1"], "--world max_cycles=-1"),
+                       *(([str(CHAMPION), "--bins", bad], f"--bins: {bad!r}: allowed: comma-separated degrees")
+                         for bad in ("0,45", "15,90", "0,45,45,90", "0,nan,90", "0,x,90", "0,60,30,90", "")),
                        ([str(ROOT / "docs" / "evidence" / "original-S1-force" / "champion.json"), "--own-layout"],
                         "has no layout_seed")):
-        assert fates.main(args) == 2
+        try:
+            status = fates.main(args)
+        except SystemExit as stop:  # argparse's own refusals
+            status = stop.code
+        assert status == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and says in err[0], err
