@@ -216,11 +216,19 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
             has_cone = True
             if table[s, T_RANGE] > max_range:
                 max_range = table[s, T_RANGE]
-    # squared centre distance below which some sensor may see a robot / a block
+    # squared centre distance below which some sensor / sensor s may see a robot / a block (a
+    # mount lies r from its robot's centre; a robot is a disc of radius r, a block a square of
+    # half-diagonal half * sqrt(2)); farther objects are skipped, which changes no reading
     robot_reach = (r + max_range + r + 1e-9) ** 2
     block_reach = np.empty(n_blocks)
     for b in range(n_blocks):
         block_reach[b] = (r + max_range + block_half[b] * math.sqrt(2.0) + 1e-9) ** 2
+    sensor_robot_reach = np.empty(n_sensors)
+    sensor_block_reach = np.empty((n_blocks, n_sensors))
+    for s in range(n_sensors):
+        sensor_robot_reach[s] = (r + table[s, T_RANGE] + r + 1e-9) ** 2
+        for b in range(n_blocks):
+            sensor_block_reach[b, s] = (r + table[s, T_RANGE] + block_half[b] * math.sqrt(2.0) + 1e-9) ** 2
     mx = np.empty(n_sensors)
     my = np.empty(n_sensors)
     hx = np.empty(n_sensors)
@@ -261,10 +269,11 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
                     oy = robot_pos[w, k, 1]
                     cdx = ox - px
                     cdy = oy - py
-                    if cdx * cdx + cdy * cdy >= robot_reach:
+                    gap = cdx * cdx + cdy * cdy
+                    if gap >= robot_reach:
                         continue
                     for s in range(n_sensors):
-                        if int(table[s, T_TYPE]) == BOTTOM:
+                        if int(table[s, T_TYPE]) == BOTTOM or gap >= sensor_robot_reach[s]:
                             continue
                         vx = -(mx[s] - ox)
                         vy = -(my[s] - oy)
@@ -281,13 +290,14 @@ def sense(robot_pos, robot_angle, block_pos, block_angle, block_half, block_need
                     oy = block_pos[w, b, 1]
                     cdx = ox - px
                     cdy = oy - py
-                    if cdx * cdx + cdy * cdy >= block_reach[b]:
+                    gap = cdx * cdx + cdy * cdy
+                    if gap >= block_reach[b]:
                         continue
                     c = bcos[b]
                     sn = bsin[b]
                     half = block_half[b]
                     for s in range(n_sensors):
-                        if int(table[s, T_TYPE]) == BOTTOM:
+                        if int(table[s, T_TYPE]) == BOTTOM or gap >= sensor_block_reach[b, s]:
                             continue
                         rx = mx[s] - ox
                         ry = my[s] - oy
