@@ -33,7 +33,9 @@ PettingZoo API 1.26x, 16 worlds per call 2.8x per world; the Java ran 12 800 ste
 from __future__ import annotations
 
 import argparse
+import json
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -45,6 +47,7 @@ from gathering_env.reference.sensing import SensorBank
 from gathering_env.vector import VectorSimulation
 
 ENV = dict(environment=2, num_robots=20)
+EVOLVED = Path(__file__).resolve().parent.parent / "docs" / "evidence" / "original-S1-v11" / "champion-gen65.json"
 #: ``--drive``: the robot drive timed (``gathering_env.drive``); the default is the paper's.
 DRIVES = {"velocity": {}, "force": ORIGINAL_FORCE_DRIVE, "shuffled": {**ORIGINAL_FORCE_DRIVE, **ORIGINAL_SCHEDULE}}
 JAVA_SIDE_BY_SIDE = ("measured 2026-11, one session, controller included on both sides: fast path 1.9x the Java, "
@@ -121,6 +124,9 @@ SUITES = {
     "10 x infrared 10": Morphology([SensorSpec("infrared", b, 0.0, 10.0, 1.0) for b in np.linspace(-3, 3, 10)]),
     "10 x ultrasonic 25": Morphology([SensorSpec("ultrasonic", b, 0.0, 25.0, 1.0) for b in np.linspace(-3, 3, 10)]),
     "10 x camera 20": Morphology([SensorSpec("camera", b, 0.0, 20.0, 1.0) for b in np.linspace(-3, 3, 10)]),
+    # an evolved suite of mixed ranges: S1 version 11's generation-65 champion (bottom, 5 infrared
+    # of range 4-6, 2 colour of 6, 2 ultrasonic of 15)
+    "evolved mix 4-15": Morphology.coerce(json.loads(EVOLVED.read_text())["morphology"]),
 }
 
 
@@ -162,7 +168,11 @@ def main() -> None:
     parser.add_argument("--java", type=float, default=None, metavar="STEPS_PER_S",
                         help="the Java original's steps/s measured the same day: also print each path "
                              "as a multiple of it")
+    parser.add_argument("--sensing-only", action="store_true", help="time the sensing alone, nothing else")
     args = parser.parse_args()
+    if args.sensing_only:
+        sensing_costs()
+        return
     if args.java is not None and not args.java > 0:
         parser.error(f"--java {args.java}: allowed: a number of steps per second > 0")
     ENV.update(DRIVES[args.drive])
