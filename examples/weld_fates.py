@@ -43,7 +43,8 @@ def bins_arg(text: str) -> tuple[float, ...]:
         edges = tuple(float(part) for part in text.split(","))
     except ValueError:
         edges = ()
-    if len(edges) < 2 or not all(map(math.isfinite, edges)) or edges[0] != 0.0 or edges[-1] != 90.0 or any(b <= a for a, b in zip(edges, edges[1:])):
+    rising = len(edges) >= 2 and all(map(math.isfinite, edges)) and all(b > a for a, b in zip(edges, edges[1:]))
+    if not rising or edges[0] != 0.0 or edges[-1] != 90.0:
         raise argparse.ArgumentTypeError(f"{text!r}: allowed: comma-separated degrees rising from 0 to 90, "
                                          "such as 0,15,45,90")
     return edges
