@@ -153,6 +153,7 @@ RECORD_CURVES = {
     "original-s1-five-seed2": ("original-S1-five-seed2", "S1-original (version 3), five schedules, seed 2"),
     "original-m1-five": ("original-M1-five", "M1-original (version 3), five schedules a genome"),
     "original-s1-v4": ("original-S1-v4", "S1-original (version 4: Encog's truncation and weights)"),
+    "original-s1-v11": ("original-S1-v11", "S1-original (version 11: the original's welded robot), converged"),
 }
 
 
